@@ -13,9 +13,9 @@ namespace fieldguard::nmea {
 
 enum class Error : std::uint8_t {
   NoStart,        // does not start with '$'
-  TooLong,        // over the 82-character limit (with some slack for real receivers, see nmea.cpp)
+  TooLong,        // over the 82-character limit (with some slack for real receivers, see src/drivers/nmea_sentence.hpp)
   BadChecksum,    // '*hh' present and wrong
-  NoChecksum,     // no '*hh' (accepted only if the caller allows it)
+  NoChecksum,     // no '*hh' (always an error for now: no caller option to accept unchecked sentences yet)
   BadField,       // a field that must be a number is not
   Unsupported,    // a sentence type we do not decode
 };

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fieldguard/core/bytes.hpp"
@@ -51,7 +52,7 @@ class Decoder {
  private:
   DecoderOptions options_;
   Calibration calibration_;
-  // Precomputed per laser: cos/sin of vertical angle, azimuth correction in 0.01 degree, firing offset.
+  // Precomputed per laser: cos/sin of the vertical angle, azimuth correction in 0.01 degree, offsets.
   struct LaserTable {
     float cos_vert;
     float sin_vert;

@@ -1,0 +1,107 @@
+#include "fieldguard/drivers/velodyne_stream.hpp"
+
+#include <numeric>
+#include <stdexcept>
+
+namespace fieldguard::velodyne {
+
+std::uint64_t StreamCounters::rejected() const { return std::accumulate(errors.begin(), errors.end(), std::uint64_t{0}); }
+
+Stream::Stream(StreamOptions options) : options_(std::move(options)), assembler_(options_.rotation_cut_deg) {
+  if (options_.calibration && options_.model == Model::Unknown) options_.model = options_.calibration->model;
+  if (options_.calibration && options_.calibration->model != options_.model) {
+    throw std::invalid_argument("the calibration is for a " + std::string(to_string(options_.calibration->model)) +
+                                " but the model is " + std::string(to_string(options_.model)));
+  }
+  if (options_.model != Model::Unknown) start_decoder(options_.model);
+}
+
+std::optional<Model> Stream::model() const {
+  if (decoder_) return decoder_->model();
+  return std::nullopt;
+}
+
+void Stream::start_decoder(Model m) {
+  DecoderOptions d;
+  d.model = m;
+  d.timestamp_reference = options_.timestamp_reference;
+  d.min_range_m = options_.min_range_m;
+  d.max_range_m = options_.max_range_m;
+  decoder_.emplace(options_.calibration ? *options_.calibration : default_calibration(m), d);
+}
+
+void Stream::count_frames(const std::vector<LidarFrame>& done, std::size_t from) {
+  for (std::size_t i = from; i < done.size(); ++i) {
+    ++(done[i].partial ? counters_.partial_rotations : counters_.full_rotations);
+  }
+}
+
+void Stream::decode_one(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done) {
+  scratch_.clear();
+  const auto header = decoder_->decode(payload, scratch_);
+  if (!header) {
+    ++counters_.errors[static_cast<std::size_t>(header.error())];
+    return;
+  }
+  ++counters_.decoded;
+  counters_.points += scratch_.size();
+  const Stamp sensor = sensor_time_from_hour_offset(header->timestamp_us, host_time);
+  const std::size_t before = done.size();
+  assembler_.push(scratch_, sensor, host_time, done);
+  count_frames(done, before);
+}
+
+void Stream::push(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done) {
+  ++counters_.packets;
+  const auto header = read_packet_header(payload);
+  if (!header) {
+    ++counters_.errors[static_cast<std::size_t>(header.error())];
+    return;
+  }
+  if (!detector_.decided()) detector_.observe(*header);
+
+  if (!decoder_) {
+    held_.push_back({std::vector<std::uint8_t>(payload.begin(), payload.end()), host_time});
+    std::optional<Model> m = detector_.decided();
+    if (!m && held_.size() >= options_.max_undecided_packets) {
+      // The spacing never settled (gaps, a stream of one packet per hour...): fall back on the product byte.
+      if (header->product_byte == 0x22 || header->product_byte == 0x24) m = Model::VLP16;
+      if (header->product_byte == 0x21) m = Model::HDL32E;
+    }
+    if (!m) {
+      if (held_.size() >= options_.max_undecided_packets) {
+        ++counters_.errors[static_cast<std::size_t>(DecodeError::NoModel)];
+        held_.erase(held_.begin());
+      }
+      return;
+    }
+    start_decoder(*m);
+    auto held = std::move(held_);
+    held_.clear();
+    for (const auto& h : held) decode_one(h.bytes, h.host, done);
+    return;
+  }
+  decode_one(payload, host_time, done);
+}
+
+void Stream::finish(std::vector<LidarFrame>& done) {
+  if (!decoder_ && !held_.empty()) {
+    // Too few packets to measure the spacing: the product byte is all there is.
+    const auto header = read_packet_header(held_.front().bytes);
+    std::optional<Model> m;
+    if (header && (header->product_byte == 0x22 || header->product_byte == 0x24)) m = Model::VLP16;
+    if (header && header->product_byte == 0x21) m = Model::HDL32E;
+    if (m) {
+      start_decoder(*m);
+      for (const auto& h : held_) decode_one(h.bytes, h.host, done);
+    } else {
+      counters_.errors[static_cast<std::size_t>(DecodeError::NoModel)] += held_.size();
+    }
+    held_.clear();
+  }
+  const std::size_t before = done.size();
+  assembler_.finish(done);
+  count_frames(done, before);
+}
+
+}  // namespace fieldguard::velodyne
