@@ -1,5 +1,56 @@
 #include "fieldguard/app/cli.hpp"
 
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "app/commands.hpp"
+#include "fieldguard/core/version.hpp"
+
 namespace fieldguard::app {
-int run_cli(int /*argc*/, char** /*argv*/) { return 0; }  // wired up in the next commit
+namespace {
+
+constexpr const char* kUsage =
+    "usage: fieldguard <command> [options]\n"
+    "\n"
+    "Obstacle detection for autonomous tractors: LiDAR, GNSS and AHRS in, obstacles and a stop request out.\n"
+    "\n"
+    "commands:\n"
+    "  replay         run captured sensor data (pcap) through the pipeline\n"
+    "  check-config   validate a configuration file and list every problem\n"
+    "\n"
+    "options:\n"
+    "  --help         this text; `fieldguard <command> --help` for a command's options\n"
+    "  --version      print the version\n";
+
+}  // namespace
+
+int run_cli(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    std::fputs(kUsage, stderr);
+    return kExitBadInput;
+  }
+  const std::string cmd = args.front();
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  try {
+    if (cmd == "--help" || cmd == "-h" || cmd == "help") {
+      std::fputs(kUsage, stdout);
+      return kExitOk;
+    }
+    if (cmd == "--version") {
+      std::printf("%s\n", version_string());
+      return kExitOk;
+    }
+    if (cmd == "check-config") return cmd_check_config(rest);
+    if (cmd == "replay") return cmd_replay(rest);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fieldguard %s: internal error: %s\n", cmd.c_str(), e.what());
+    return kExitFailure;
+  }
+  std::fprintf(stderr, "fieldguard: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
+  return kExitBadInput;
+}
+
 }  // namespace fieldguard::app

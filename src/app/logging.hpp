@@ -1,0 +1,14 @@
+#pragma once
+// One named spdlog logger per module, all to stderr with a fixed pattern and no timestamps of our own
+// (under systemd the journal stamps lines). Private to the app module: no spdlog type leaves it.
+
+#include <spdlog/logger.h>
+
+#include <memory>
+#include <string>
+
+namespace fieldguard::app {
+
+[[nodiscard]] std::shared_ptr<spdlog::logger> logger(const std::string& name);
+
+}  // namespace fieldguard::app

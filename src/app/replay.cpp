@@ -1,0 +1,256 @@
+// `fieldguard replay`: captured packets through the same decoders the daemon runs live.
+
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "app/args.hpp"
+#include "app/commands.hpp"
+#include "app/logging.hpp"
+#include "app/pcd_writer.hpp"
+#include "fieldguard/app/config.hpp"
+#include "fieldguard/drivers/velodyne_position.hpp"
+#include "fieldguard/drivers/velodyne_stream.hpp"
+#include "fieldguard/io/pcap_reader.hpp"
+
+namespace fieldguard::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kHelp =
+    "usage: fieldguard replay --config FILE --pcap FILE [--pcd-dir DIR] [--quiet]\n"
+    "\n"
+    "Runs a capture of Velodyne packets (classic pcap or pcapng; Ethernet, VLAN, Linux cooked SLL/SLL2 or raw\n"
+    "IPv4) through the decoder and cuts it into rotations.\n"
+    "\n"
+    "  --config FILE   configuration (see config/fieldguard.yaml)\n"
+    "  --pcap FILE     the capture\n"
+    "  --pcd-dir DIR   write one binary PCD per rotation: frame_NNNNNN.pcd, and frame_NNNNNN_partial.pcd for\n"
+    "                  the first and last rotations when they are not a full turn (fields x y z intensity ring\n"
+    "                  time; sensor frame x forward, y left, z up, metres; time in s after the rotation start)\n"
+    "  --quiet         no progress line\n"
+    "\n"
+    "Ends with a summary: packets read, decoded, dropped by reason, rotations, points, wall time.\n"
+    "Exit code 0 when the capture was used, 2 for unusable input (missing or unreadable file, not a pcap,\n"
+    "no Velodyne data in it, invalid configuration), 1 when writing the output failed.\n";
+
+struct PositionCounters {
+  std::uint64_t packets = 0;
+  std::uint64_t decoded = 0;
+  std::uint64_t bad_length = 0;
+  std::uint64_t rmc = 0;
+  std::uint64_t nmea_rejected = 0;
+  std::optional<velodyne::PositionPacket> last;
+};
+
+struct PortCounters {
+  std::uint64_t data_bad_length = 0;
+  std::uint64_t other_port = 0;
+};
+
+std::string fmt_rmc(const nmea::Rmc& r) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s %04d-%02d-%02d lat %.6f lon %.6f", r.valid ? "valid" : "not valid",
+                r.year.value_or(0), r.month.value_or(0), r.day.value_or(0), r.lat_deg.value_or(0.0),
+                r.lon_deg.value_or(0.0));
+  return buf;
+}
+
+void print_summary(const std::string& pcap, const io::PcapStats& ps, const velodyne::Stream& stream,
+                   const PositionCounters& pos, const PortCounters& ports, std::uint64_t written, double wall_s,
+                   double span_s) {
+  const auto& c = stream.counters();
+  std::printf("replay summary: %s\n", pcap.c_str());
+  std::printf("  records read      %llu\n", static_cast<unsigned long long>(ps.records));
+  std::printf("  udp datagrams     %llu\n", static_cast<unsigned long long>(ps.datagrams));
+  std::printf("  data packets      %llu read, %llu decoded\n", static_cast<unsigned long long>(c.packets),
+              static_cast<unsigned long long>(c.decoded));
+  std::printf("  position packets  %llu read, %llu decoded, %llu with RMC\n",
+              static_cast<unsigned long long>(pos.packets), static_cast<unsigned long long>(pos.decoded),
+              static_cast<unsigned long long>(pos.rmc));
+  if (pos.last) {
+    std::printf("  last position     pps %s", std::string(velodyne::to_string(pos.last->pps)).c_str());
+    if (pos.last->rmc) std::printf(", RMC %s", fmt_rmc(*pos.last->rmc).c_str());
+    std::printf("\n");
+  }
+  const auto m = stream.model();
+  std::printf("  model             %s", m ? std::string(velodyne::to_string(*m)).c_str() : "undecided");
+  if (!stream.detector().reason().empty()) std::printf(" (stream: %s)", stream.detector().reason().c_str());
+  std::printf("\n");
+
+  std::uint64_t dropped = 0;
+  std::string reasons;
+  auto add = [&](const std::string& name, std::uint64_t n) {
+    if (n == 0) return;
+    dropped += n;
+    reasons += "    " + name + std::string(name.size() < 24 ? 24 - name.size() : 1, ' ') + std::to_string(n) + "\n";
+  };
+  for (std::size_t i = 0; i < io::kFrameDropCount; ++i) add(std::string(io::to_string(static_cast<io::FrameDrop>(i))), ps.drops[i]);
+  add("other_port", ports.other_port);
+  add("data_bad_length", ports.data_bad_length);
+  add("position_bad_length", pos.bad_length);
+  add("position_nmea_rejected", pos.nmea_rejected);
+  for (std::size_t i = 0; i < velodyne::kDecodeErrorCount; ++i) {
+    add("data_" + std::string(velodyne::to_string(static_cast<velodyne::DecodeError>(i))), c.errors[i]);
+  }
+  std::printf("  dropped           %llu\n%s", static_cast<unsigned long long>(dropped), reasons.c_str());
+  if (ps.truncated) std::printf("  file truncated    yes: the capture ends inside a record\n");
+  if (!ps.read_error.empty()) std::printf("  read error        %s\n", ps.read_error.c_str());
+  std::printf("  rotations         %llu full, %llu partial\n", static_cast<unsigned long long>(c.full_rotations),
+              static_cast<unsigned long long>(c.partial_rotations));
+  std::printf("  points            %llu\n", static_cast<unsigned long long>(c.points));
+  if (written > 0) std::printf("  pcd files         %llu\n", static_cast<unsigned long long>(written));
+  std::printf("  capture span      %.3f s\n", span_s);
+  std::printf("  wall time         %.3f s\n", wall_s);
+}
+
+}  // namespace
+
+int cmd_replay(const std::vector<std::string>& argv) {
+  const Args args(argv, {"config", "pcap", "pcd-dir"}, {"help", "quiet"});
+  if (args.has("help")) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  if (!args.ok() || !args.positional().empty() || !args.has("config") || !args.has("pcap")) {
+    std::fprintf(stderr, "fieldguard replay: %s\n%s",
+                 !args.ok() ? args.error().c_str()
+                 : !args.positional().empty() ? ("unexpected argument '" + args.positional().front() + "'").c_str()
+                                               : "--config and --pcap are required",
+                 kHelp);
+    return kExitBadInput;
+  }
+  const auto log = logger("replay");
+  const auto started = std::chrono::steady_clock::now();
+
+  const auto loaded = load_config_file(*args.get("config"));
+  if (!loaded.ok()) {
+    for (const auto& issue : loaded.issues) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
+    std::fprintf(stderr, "fieldguard replay: invalid configuration %s\n", args.get("config")->c_str());
+    return kExitBadInput;
+  }
+  const Config& cfg = loaded.config;
+
+  const std::string pcap_path = *args.get("pcap");
+  auto reader = io::PcapReader::open(pcap_path);
+  if (!reader) {
+    std::fprintf(stderr, "fieldguard replay: %s\n", reader.error().c_str());
+    return kExitBadInput;
+  }
+
+  std::string pcd_dir;
+  if (auto d = args.get("pcd-dir")) {
+    pcd_dir = *d;
+    std::error_code ec;
+    fs::create_directories(pcd_dir, ec);
+    if (ec || !fs::is_directory(pcd_dir)) {
+      std::fprintf(stderr, "fieldguard replay: cannot create the PCD directory %s: %s\n", pcd_dir.c_str(),
+                   ec ? ec.message().c_str() : "a file of that name exists");
+      return kExitBadInput;
+    }
+  }
+
+  velodyne::StreamOptions so;
+  so.model = cfg.lidar.model;
+  if (cfg.lidar.has_calibration) so.calibration = cfg.lidar.calibration;
+  so.timestamp_reference = cfg.lidar.timestamp_reference;
+  so.min_range_m = cfg.lidar.min_range_m;
+  so.max_range_m = cfg.lidar.max_range_m;
+  so.rotation_cut_deg = cfg.lidar.rotation_cut_deg;
+  velodyne::Stream stream(so);
+
+  PositionCounters pos;
+  PortCounters ports;
+  std::vector<LidarFrame> frames;
+  std::uint64_t written = 0;
+  std::string write_error;
+  Stamp first_time;
+  Stamp last_time;
+  const bool progress = !args.has("quiet") && isatty(STDERR_FILENO) != 0;
+  auto last_progress = started;
+
+  auto handle_frames = [&]() {
+    for (const auto& f : frames) {
+      if (pcd_dir.empty() || !write_error.empty()) continue;
+      char name[64];
+      std::snprintf(name, sizeof name, "frame_%06llu%s.pcd", static_cast<unsigned long long>(f.index),
+                    f.partial ? "_partial" : "");
+      write_error = write_pcd((fs::path(pcd_dir) / name).string(), f);
+      if (write_error.empty()) ++written;
+    }
+    frames.clear();
+  };
+
+  while (auto dg = reader->next()) {
+    if (first_time.ns == 0) first_time = dg->host_time;
+    last_time = dg->host_time;
+    if (dg->dst_port == cfg.lidar.data_port) {
+      if (dg->payload.size() != velodyne::kDataPacketSize) {
+        ++ports.data_bad_length;
+        continue;
+      }
+      stream.push(dg->payload, dg->host_time, frames);
+      handle_frames();
+    } else if (dg->dst_port == cfg.lidar.position_port) {
+      ++pos.packets;
+      auto p = velodyne::decode_position_packet(dg->payload);
+      if (!p) {
+        ++pos.bad_length;
+        continue;
+      }
+      ++pos.decoded;
+      if (p->rmc) ++pos.rmc;
+      if (p->nmea_error) ++pos.nmea_rejected;
+      pos.last = std::move(p).value();
+    } else {
+      ++ports.other_port;
+    }
+    if (progress) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_progress > std::chrono::seconds(1)) {
+        last_progress = now;
+        std::fprintf(stderr, "\r  %llu records, %llu rotations ...", static_cast<unsigned long long>(reader->stats().records),
+                     static_cast<unsigned long long>(stream.counters().full_rotations + stream.counters().partial_rotations));
+      }
+    }
+  }
+  stream.finish(frames);
+  handle_frames();
+  if (progress) std::fprintf(stderr, "\r%60s\r", "");
+
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  print_summary(pcap_path, reader->stats(), stream, pos, ports, written, wall_s,
+                static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
+
+  if (reader->stats().truncated) log->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path);
+  if (!reader->stats().read_error.empty()) log->warn("{}: reading stopped early: {}", pcap_path, reader->stats().read_error);
+  if (cfg.lidar.model != velodyne::Model::Unknown && stream.detector().decided() &&
+      *stream.detector().decided() != cfg.lidar.model) {
+    log->warn("lidar.model is {} but the packets look like a {} ({}); check the configuration",
+              velodyne::to_string(cfg.lidar.model), velodyne::to_string(*stream.detector().decided()),
+              stream.detector().reason());
+  }
+  if (!write_error.empty()) {
+    std::fprintf(stderr, "fieldguard replay: %s\n", write_error.c_str());
+    return kExitFailure;
+  }
+  if (stream.counters().packets == 0) {
+    std::fprintf(stderr, "fieldguard replay: %s holds no UDP datagram to the data port %u: not a Velodyne capture, or "
+                 "lidar.data_port is wrong\n", pcap_path.c_str(), cfg.lidar.data_port);
+    return kExitBadInput;
+  }
+  if (stream.counters().decoded == 0) {
+    std::fprintf(stderr, "fieldguard replay: none of the %llu datagrams to port %u in %s is a Velodyne data packet\n",
+                 static_cast<unsigned long long>(stream.counters().packets), cfg.lidar.data_port, pcap_path.c_str());
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+}  // namespace fieldguard::app
