@@ -7,12 +7,15 @@
 
 namespace fieldguard::app {
 
-struct EIGEN_ALIGN16 PcdPoint {
-  PCL_ADD_POINT4D;
+// A plain record (PCL's PCL_ADD_POINT4D relies on anonymous structs, a GNU extension); the PCD writer only
+// needs the registered fields.
+struct PcdPoint {
+  float x;
+  float y;
+  float z;
   float intensity;
   std::uint16_t ring;
   float time;  // seconds after the frame's sensor stamp
-  PCL_MAKE_ALIGNED_OPERATOR_NEW
 };
 
 }  // namespace fieldguard::app
@@ -27,11 +30,10 @@ std::string write_pcd(const std::string& path, const LidarFrame& frame) {
   pcl::PointCloud<PcdPoint> cloud;
   cloud.reserve(frame.points.size());
   for (const auto& p : frame.points) {
-    PcdPoint q;
+    PcdPoint q{};
     q.x = p.x;
     q.y = p.y;
     q.z = p.z;
-    q.data[3] = 1.0F;
     q.intensity = p.intensity;
     q.ring = p.ring;
     q.time = p.time_s;

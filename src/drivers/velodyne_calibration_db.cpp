@@ -9,6 +9,7 @@
 // sequence). The laser count is the number of enabled slots (the number of points_ items if there is no
 // enabled_ list), and only ids below it are read.
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -118,7 +119,33 @@ void read_point(const pt::ptree& item, std::size_t index, detail::LaserTable& ta
   };
 }
 
+// Deepest element nesting in the text, counted over tags; Boost's XML reader recurses once per level, so a
+// hostile file could exhaust the stack. A real db.xml nests 6 deep.
+std::size_t nesting_depth(std::string_view xml) {
+  std::size_t depth = 0;
+  std::size_t deepest = 0;
+  for (std::size_t i = 0; i + 1 < xml.size(); ++i) {
+    if (xml[i] != '<') continue;
+    const char next = xml[i + 1];
+    if (next == '/') {
+      depth = depth > 0 ? depth - 1 : 0;
+    } else if (next != '?' && next != '!') {
+      const auto close = xml.find('>', i);
+      if (close == std::string_view::npos) break;
+      if (xml[close - 1] != '/') deepest = std::max(deepest, ++depth);
+      i = close;
+    }
+  }
+  return deepest;
+}
+
+constexpr std::size_t kMaxNesting = 64;
+
 Expected<Calibration, std::string> parse_db(std::string_view xml_text) {
+  if (nesting_depth(xml_text) > kMaxNesting) {
+    return Unexpected{"elements nest more than " + std::to_string(kMaxNesting) +
+                      " deep: not a db.xml (a VeloView calibration nests 6 deep)"};
+  }
   pt::ptree tree;
   std::istringstream in{std::string(xml_text)};
   pt::read_xml(in, tree, pt::xml_parser::trim_whitespace);

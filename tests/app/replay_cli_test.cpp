@@ -122,7 +122,7 @@ TEST(Replay, TruncatedFileKeepsEverythingBeforeTheCut) {
   std::size_t last = off;
   while (off + 16 <= bytes.size()) {
     last = off;
-    const std::size_t caplen = bytes[off + 8] | (bytes[off + 9] << 8) | (bytes[off + 10] << 16);
+    const std::size_t caplen = bytes[off + 8] | (std::size_t{bytes[off + 9]} << 8) | (std::size_t{bytes[off + 10]} << 16);
     off += 16 + caplen;
   }
   ASSERT_EQ(off, bytes.size());

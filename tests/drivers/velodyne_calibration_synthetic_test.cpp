@@ -175,6 +175,12 @@ struct Malformed {
   const char* message;  // expected in the error
 };
 
+std::string repeated(const std::string& s, int n) {
+  std::string out;
+  for (int i = 0; i < n; ++i) out += s;
+  return out;
+}
+
 std::vector<Malformed> malformed_cases() {
   auto missing_vert = ros_lasers(32);
   missing_vert[7] = without(missing_vert[7], "vert_correction");
@@ -225,6 +231,7 @@ std::vector<Malformed> malformed_cases() {
       {"DbNonNumericField", Format::Db, db_xml(db_word, {}), "laser 3: distCorrection_ is not a number: '12cm'"},
       {"DbDuplicateId", Format::Db, db_xml(db_dup, enabled_run(32, 33)), "laser 32: id_ 0 appears twice"},
       {"DbEnabledGap", Format::Db, db_xml(db_points(32), with_gap()), "enabled_ item 20 is enabled after disabled laser 16"},
+      {"DbNestedTooDeep", Format::Db, repeated("<a>", 20000), "elements nest more than 64 deep"},
   };
 }
 
