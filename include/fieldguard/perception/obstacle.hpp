@@ -1,0 +1,55 @@
+#pragma once
+// What the detection pipeline reports: one obstacle per kept cluster, in the 3D LiDAR's sensor frame
+// (x forward, y left, z up, metres).
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace fieldguard::perception {
+
+// small: person-sized (fits in 1.2 m x 1.2 m x 2.2 m); large: implement, haystack, building, tree.
+enum class SizeClass : std::uint8_t { Small = 0, Large = 1 };
+[[nodiscard]] std::string_view to_string(SizeClass c);
+
+struct Obstacle {
+  std::array<float, 3> min{};        // axis-aligned box (m)
+  std::array<float, 3> max{};
+  // Oriented box in x-y (minimum-area rectangle of the cluster's footprint), z from the axis-aligned box.
+  std::array<float, 2> obb_center{};  // (m)
+  float obb_length_m = 0.F;           // along obb_yaw
+  float obb_width_m = 0.F;
+  float obb_yaw_rad = 0.F;            // of the length axis from x, counter-clockwise, in (-pi/2, pi/2]
+  std::uint32_t points = 0;           // points in the cluster (after voxel downsampling)
+  float distance_m = 0.F;             // horizontal distance from the sensor to the nearest point of the cluster
+  float bearing_deg = 0.F;            // atan2(y, x) of the box centre, degrees, + to the left
+  float height_above_ground_m = 0.F;  // highest point above the local ground under the cluster
+  SizeClass size_class = SizeClass::Small;
+};
+
+// Points of the processed frame with what the pipeline made of them, for pictures and debugging.
+enum class PointLabel : std::uint8_t { Ground = 0, Obstacle = 1, Rejected = 2 /* clustered, filtered out */, Unclustered = 3 };
+struct LabeledPoint {
+  float x = 0.F;
+  float y = 0.F;
+  float z = 0.F;
+  PointLabel label = PointLabel::Unclustered;
+};
+
+// How many points each stage kept, for the summary, the benchmarks and the status.
+struct StageCounts {
+  std::uint32_t input = 0;
+  std::uint32_t after_roi = 0;    // inside the ROI and outside the body box
+  std::uint32_t after_voxel = 0;
+  std::uint32_t ground = 0;
+  std::uint32_t clusters = 0;     // before the filters
+  std::uint32_t obstacles = 0;    // after the filters
+};
+
+struct FrameResult {
+  std::vector<Obstacle> obstacles;  // sorted by distance_m, nearest first; ties by bearing
+  StageCounts counts;
+};
+
+}  // namespace fieldguard::perception

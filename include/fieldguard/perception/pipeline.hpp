@@ -1,0 +1,38 @@
+#pragma once
+// One LiDAR rotation in, obstacles out: ROI and body removal, voxel grid, ground segmentation, Euclidean
+// clustering, cluster filters, obstacle boxes. Value types only: no sockets, no config parsing, no logging.
+// Thread-compatible: a Pipeline holds scratch buffers, so each worker thread owns one; the output depends
+// only on the input points and the parameters (deterministic, whatever thread runs it).
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/perception/obstacle.hpp"
+#include "fieldguard/perception/params.hpp"
+
+namespace fieldguard::perception {
+
+class Pipeline {
+ public:
+  // Throws std::invalid_argument for parameters no pipeline can run with (the config loader has already
+  // reported anything a user could get wrong, so this is a programming error).
+  explicit Pipeline(const PipelineParams& params);
+  ~Pipeline();
+  Pipeline(Pipeline&&) noexcept;
+  Pipeline& operator=(Pipeline&&) noexcept;
+
+  [[nodiscard]] FrameResult process(std::span<const LidarPoint> points);
+
+  // The points of the last processed frame after ROI and voxel grid, labelled; valid until the next process().
+  [[nodiscard]] std::span<const LabeledPoint> last_points() const;
+
+  [[nodiscard]] const PipelineParams& params() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fieldguard::perception
