@@ -1,0 +1,197 @@
+// fieldguard-score on hand-written frames with known answers.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "score/json.hpp"
+#include "tools/tools_test_support.hpp"
+
+namespace fieldguard::score {
+namespace {
+
+using tools_test::run;
+using tools_test::ScratchDir;
+using tools_test::write_file;
+
+// Ground truth, period 0.1 s:
+//  0 (100.0) pedestrian at 12 m            -> detected (band 10-15)
+//  1 (100.1) pedestrian at 27 m, 6 hits    -> missed (band 25-30); a false obstacle on a clod at 7 m (band 5-10)
+//  2 (100.2) implement                     -> two obstacles: detected, over-segmented
+//  3 (100.3) two haystacks 0.4 m apart     -> one obstacle: both detected, under-segmented
+//  4 (100.4) crowns A, B (0.4 m apart), C, D, E (2 hits: not visible)
+//            -> A, B true positives; C split in two; D missed; a false obstacle at 25.7 m (band 25-30)
+//  5 (100.5) crowns F, G 0.4 m apart       -> one obstacle: both merged, under-segmented
+//  6 (100.6) nothing detected at all       -> no detection frame: unmatched
+//  7 (100.7) detection frame is partial    -> skipped
+constexpr const char* kTruth =
+    R"({"frame": 0, "stamp": 100.000000, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 40, "distance_m": 12.0}], "terrain": []}
+{"frame": 1, "stamp": 100.100000, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [27.0, -0.3, -0.95], "max": [27.5, 0.3, 0.8], "hits": 6, "distance_m": 27.0}], "terrain": [{"id": "c1", "class": "clod", "min": [6.9, 0.9, -0.95], "max": [7.3, 1.2, -0.6], "hits": 9}]}
+{"frame": 2, "stamp": 100.200000, "period_s": 0.1, "objects": [{"id": "i", "class": "implement", "min": [20.0, -2.0, -0.95], "max": [23.0, 0.5, 0.55], "hits": 200, "distance_m": 20.0}]}
+
+{"frame": 3, "stamp": 100.300000, "period_s": 0.1, "objects": [{"id": "h1", "class": "haystack", "min": [15.0, 3.0, -0.95], "max": [16.5, 4.2, 0.55], "hits": 90, "distance_m": 15.3}, {"id": "h2", "class": "haystack", "min": [15.0, 4.6, -0.95], "max": [16.5, 5.8, 0.55], "hits": 80, "distance_m": 15.7}]}
+{"frame": 4, "stamp": 100.400000, "period_s": 0.1, "objects": [{"id": "A", "class": "crown", "min": [10.0, -3.0, 0.0], "max": [12.0, -1.0, 2.0], "hits": 50}, {"id": "B", "class": "crown", "min": [12.4, -3.0, 0.0], "max": [14.4, -1.0, 2.0], "hits": 40}, {"id": "C", "class": "crown", "min": [20.0, -3.0, 0.0], "max": [22.0, -1.0, 2.0], "hits": 30}, {"id": "D", "class": "crown", "min": [30.0, 2.0, 0.0], "max": [32.0, 4.0, 2.0], "hits": 20}, {"id": "E", "class": "crown", "min": [40.0, 2.0, 0.0], "max": [42.0, 4.0, 2.0], "hits": 2}]}
+{"frame": 5, "stamp": 100.500000, "period_s": 0.1, "objects": [{"id": "F", "class": "crown", "min": [10.0, -3.0, 0.0], "max": [12.0, -1.0, 2.0], "hits": 50}, {"id": "G", "class": "crown", "min": [12.4, -3.0, 0.0], "max": [14.4, -1.0, 2.0], "hits": 40}]}
+{"frame": 6, "stamp": 100.600000, "period_s": 0.1, "objects": []}
+{"frame": 7, "stamp": 100.700000, "period_s": 0.1, "objects": []}
+)";
+
+// Detection frames are numbered from 1 (the replay saw a partial rotation first) and come slightly late:
+// they must be paired by stamp. One frame (99.5) has no truth.
+constexpr const char* kDetections =
+    R"({"frame": 1, "stamp": 100.0004, "points_in": 60000, "obstacles": [{"min": [12.05, -0.2, -0.9], "max": [12.4, 0.25, 0.7], "points": 30}]}
+{"frame": 0, "stamp": 99.5, "points_in": 100, "partial": true, "obstacles": []}
+{"frame": 2, "stamp": 100.1004, "points_in": 60000, "obstacles": [{"min": [7.0, 1.0, -0.9], "max": [7.4, 1.3, -0.5], "points": 12}]}
+{"frame": 3, "stamp": 100.2004, "points_in": 60000, "partial": false, "obstacles": [{"min": [20.0, -2.0, -0.9], "max": [21.2, 0.5, 0.5], "points": 60}, {"min": [21.8, -2.0, -0.9], "max": [23.0, 0.5, 0.5], "points": 70}]}
+{"frame": 4, "stamp": 100.3004, "points_in": 60000, "obstacles": [{"min": [15.0, 3.0, -0.9], "max": [16.5, 5.8, 0.5], "points": 150, "distance_m": 15.3}]}
+{"frame": 5, "stamp": 100.4004, "points_in": 60000, "obstacles": [{"min": [10.0, -2.9, 0.1], "max": [12.15, -1.1, 1.9]}, {"min": [12.5, -2.9, 0.1], "max": [14.3, -1.1, 1.9]}, {"min": [20.0, -3.0, 0.1], "max": [21.0, -1.0, 1.9]}, {"min": [21.1, -3.0, 0.1], "max": [22.0, -1.0, 1.9]}, {"min": [25.0, 6.0, 0.0], "max": [25.5, 6.5, 1.0]}]}
+{"frame": 6, "stamp": 100.5004, "points_in": 60000, "obstacles": [{"min": [10.1, -2.9, 0.1], "max": [14.3, -1.1, 1.9]}]}
+{"frame": 8, "stamp": 100.7004, "points_in": 30000, "partial": true, "obstacles": [{"min": [5.0, 5.0, 0.0], "max": [5.5, 5.5, 1.0]}]}
+)";
+
+class ScoreCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    write_file(dir_.file("truth.jsonl"), kTruth);
+    write_file(dir_.file("det.jsonl"), kDetections);
+  }
+  [[nodiscard]] JsonValue score_json(const std::string& extra = "") const {
+    const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file("det.jsonl") + " --truth " +
+                                             dir_.file("truth.jsonl") + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.errors;
+    const auto parsed = parse_json(r.output);
+    EXPECT_TRUE(parsed.value) << r.output;
+    return parsed.value.value_or(JsonValue{});
+  }
+  static double num(const JsonValue& v, std::initializer_list<const char*> path) {
+    const JsonValue* p = &v;
+    for (const char* k : path) {
+      p = p->find(k);
+      if (p == nullptr) return -1.0;
+    }
+    return p->kind == JsonValue::Kind::Null ? -2.0 : p->number;
+  }
+  static const JsonValue& band(const JsonValue& v, const char* list, std::size_t i) { return v.find(list)->items.at(i); }
+  ScratchDir dir_{"score"};
+};
+
+TEST_F(ScoreCli, FramesArePairedByStamp) {
+  const JsonValue v = score_json();
+  EXPECT_EQ(num(v, {"frames", "truth"}), 8);
+  EXPECT_EQ(num(v, {"frames", "detections"}), 8);
+  EXPECT_EQ(num(v, {"frames", "matched"}), 7);
+  EXPECT_EQ(num(v, {"frames", "partial_skipped"}), 1);
+  EXPECT_EQ(num(v, {"frames", "scored"}), 6);
+  const JsonValue* tu = v.find("frames")->find("truth_unmatched_lines");
+  ASSERT_EQ(tu->items.size(), 1U);
+  EXPECT_EQ(tu->items[0].number, 8);  // line 8 of the truth file: frame 6 (line 4 is blank)
+  const JsonValue* du = v.find("frames")->find("detections_unmatched_lines");
+  ASSERT_EQ(du->items.size(), 1U);
+  EXPECT_EQ(du->items[0].number, 2);
+  EXPECT_NEAR(num(v, {"params", "tolerance_s"}), 0.05, 1e-9);
+}
+
+TEST_F(ScoreCli, PedestrianDetectionAndMissByBand) {
+  const JsonValue v = score_json();
+  const JsonValue& b10 = band(v, "pedestrian", 2);
+  EXPECT_EQ(b10.find("band")->string, "10-15");
+  EXPECT_EQ(b10.find("visible")->number, 1);
+  EXPECT_EQ(b10.find("detected")->number, 1);
+  EXPECT_EQ(b10.find("rate")->number, 1.0);
+  const JsonValue& b25 = band(v, "pedestrian", 5);
+  EXPECT_EQ(b25.find("visible")->number, 1);
+  EXPECT_EQ(b25.find("detected")->number, 0);
+  EXPECT_EQ(band(v, "pedestrian", 0).find("rate")->kind, JsonValue::Kind::Null);
+  EXPECT_EQ(num(v, {"classes", "pedestrian", "visible"}), 2);
+  EXPECT_EQ(num(v, {"classes", "pedestrian", "detected"}), 1);
+  // With --min-hits 7 the 6-return pedestrian is not visible: the miss no longer counts.
+  const JsonValue w = score_json(" --min-hits 7");
+  EXPECT_EQ(band(w, "pedestrian", 5).find("visible")->number, 0);
+}
+
+TEST_F(ScoreCli, GroundFalseDetectionsByBand) {
+  const JsonValue v = score_json();
+  for (std::size_t b = 0; b < 8; ++b) {
+    const JsonValue& g = band(v, "ground_false", b);
+    EXPECT_EQ(g.find("frames")->number, 6) << b;
+    const double expected = (b == 1 || b == 5) ? 1.0 : 0.0;  // the clod at 7 m; the obstacle at 25.7 m
+    EXPECT_EQ(g.find("false_frames")->number, expected) << b;
+  }
+  EXPECT_NEAR(band(v, "ground_false", 1).find("rate")->number, 1.0 / 6.0, 1e-6);
+  EXPECT_EQ(num(v, {"obstacles", "total"}), 11);
+  EXPECT_EQ(num(v, {"obstacles", "false"}), 2);
+  EXPECT_EQ(num(v, {"obstacles", "false_by_cause", "clod"}), 1);
+  EXPECT_EQ(num(v, {"obstacles", "false_by_cause", "none"}), 1);
+}
+
+TEST_F(ScoreCli, ClassesAndSegmentation) {
+  const JsonValue v = score_json();
+  EXPECT_EQ(num(v, {"classes", "implement", "rate"}), 1.0);
+  EXPECT_EQ(num(v, {"classes", "haystack", "detected"}), 2);
+  EXPECT_EQ(num(v, {"classes", "crown", "visible"}), 6);
+  EXPECT_EQ(num(v, {"classes", "crown", "detected"}), 5);
+  EXPECT_EQ(num(v, {"segmentation", "over"}), 2);   // the implement, crown C
+  EXPECT_EQ(num(v, {"segmentation", "under"}), 2);  // the haystacks, crowns F+G
+}
+
+TEST_F(ScoreCli, CrownTruePositivesFalseAndMissed) {
+  const JsonValue v = score_json();
+  EXPECT_EQ(num(v, {"crowns", "visible"}), 6);
+  EXPECT_EQ(num(v, {"crowns", "tp"}), 2);
+  EXPECT_EQ(num(v, {"crowns", "split"}), 1);
+  EXPECT_EQ(num(v, {"crowns", "missed"}), 1);
+  EXPECT_EQ(num(v, {"crowns", "merged"}), 2);
+  EXPECT_NEAR(num(v, {"crowns", "tp_rate"}), 2.0 / 6.0, 1e-6);
+  EXPECT_EQ(num(v, {"crowns", "frames"}), 2);
+  EXPECT_EQ(num(v, {"crowns", "obstacles"}), 6);
+  EXPECT_EQ(num(v, {"crowns", "false_obstacles"}), 1);
+  // A and B are 0.4 m apart and A's obstacle reaches 0.15 m past A: with the 0.3 m margin alone it would also
+  // match B (A merged, B split); the overlap rule does not let a 5 cm sliver count.
+  const JsonValue loose = score_json(" --min-overlap 0");
+  EXPECT_EQ(num(loose, {"crowns", "tp"}), 0);
+}
+
+TEST_F(ScoreCli, PartialFramesCanBeIncluded) {
+  const JsonValue v = score_json(" --include-partial");
+  EXPECT_EQ(num(v, {"frames", "scored"}), 7);
+  EXPECT_EQ(num(v, {"obstacles", "false"}), 3);
+}
+
+TEST_F(ScoreCli, TextReport) {
+  const auto r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.output.find("25-30"), std::string::npos);
+  EXPECT_NE(r.output.find("true positive 2"), std::string::npos);
+}
+
+TEST_F(ScoreCli, UnusableInputExitsTwoNamingFileAndLine) {
+  write_file(dir_.file("bad.jsonl"), std::string(kDetections).replace(0, 1, "x"));
+  auto r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("bad.jsonl") + " --truth " + dir_.file("truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("bad.jsonl:1:"), std::string::npos) << r.errors;
+
+  write_file(dir_.file("bad2.jsonl"), "{\"stamp\": 1.0, \"obstacles\": []}\n{\"stamp\": 1.1, \"obstacles\": [{\"min\": [0, 0], \"max\": [1, 1, 1]}]}\n");
+  r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("bad2.jsonl") + " --truth " + dir_.file("truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("bad2.jsonl:2: obstacles[0]"), std::string::npos) << r.errors;
+
+  write_file(dir_.file("bad3.jsonl"), "{\"stamp\": 1.0}\n");
+  r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("bad3.jsonl") + " --truth " + dir_.file("truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("missing \"obstacles\""), std::string::npos) << r.errors;
+
+  r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("nope.jsonl") + " --truth " + dir_.file("truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("nope.jsonl"), std::string::npos);
+
+  write_file(dir_.file("badtruth.jsonl"), "{\"stamp\": 1.0, \"objects\": [{\"min\": [0,0,0], \"max\": [1,1,1], \"hits\": 3}]}\n");
+  r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("badtruth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("badtruth.jsonl:1: objects[0]: \"class\""), std::string::npos) << r.errors;
+
+  EXPECT_EQ(run(FIELDGUARD_SCORE, "--truth " + dir_.file("truth.jsonl")).exit_code, 2);
+  EXPECT_EQ(run(FIELDGUARD_SCORE, "--detections a --truth b --margin -1").exit_code, 2);
+  EXPECT_EQ(run(FIELDGUARD_SCORE, "--detections a --truth b --region 1,2,3").exit_code, 2);
+}
+
+}  // namespace
+}  // namespace fieldguard::score

@@ -1,0 +1,207 @@
+// fieldguard-sim: writes an HDL-32E capture (classic pcap) of a simulated scene and its ground truth (JSONL).
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sim/hdl32e.hpp"
+#include "sim/pcap_writer.hpp"
+#include "sim/scenes.hpp"
+#include "sim/simulator.hpp"
+#include "sim/truth_writer.hpp"
+
+namespace {
+
+using namespace fieldguard::sim;
+
+constexpr std::int64_t kDefaultStartS = 1718449170;  // 2024-06-15 10:59:30 UTC: the hour turns after 30 s
+
+void usage(std::ostream& os) {
+  os << "usage: fieldguard-sim --scene NAME --pcap FILE [--truth FILE] [--rotations N] [--rate HZ]\n"
+        "                      [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
+        "       fieldguard-sim --list-scenes | --help\n\n"
+        "Simulates a Velodyne HDL-32E (strongest return, 0x37/0x21, 2 mm units) 0.95 m above a field at the\n"
+        "front of a tractor and writes its data packets as a classic pcap (Ethernet/IPv4/UDP to port 2368,\n"
+        "record time = packet time = its last firing) plus one ground-truth JSON line per rotation.\n\n"
+        "  --scene NAME        one of the scenes below\n"
+        "  --pcap FILE         capture to write\n"
+        "  --truth FILE        ground truth to write (default: FILE without .pcap + .truth.jsonl)\n"
+        "  --rotations N       rotations to simulate (default: the scene's)\n"
+        "  --rate HZ           rotation rate, 5..20 (default 10); rounded to a whole number of packets per\n"
+        "                      rotation: 10 -> 181 packets (9.991 Hz), 5 -> 362 packets (4.996 Hz)\n"
+        "  --seed N            random seed (default 1); the same seed gives byte-identical output\n"
+        "  --start-time S      Unix time of the first firing (default 1718449170 = 10:59:30 UTC, so the\n"
+        "                      packet timestamps wrap at the top of the hour after 30 s)\n"
+        "  --threads N         threads casting rays (default 1; 0 = one per hardware thread, at most 8);\n"
+        "                      the output is byte-identical for any N. Each rotation waits for all of them,\n"
+        "                      so on a busy machine more threads can be slower\n"
+        "  --quiet             no progress or summary on stderr\n\n"
+        "Every rotation starts exactly at azimuth 0 (the cut angle) with block 0 of a packet, so each one is a\n"
+        "full turn. A reader's rotation assembler may still flag the first and the last rotation of the file\n"
+        "as partial (it cannot know the first one began at the cut, and the stream ends after the last).\n\n"
+        "Scenes (default rotations in brackets):\n";
+  for (const SceneInfo& s : scene_catalog()) {
+    os << "  " << s.name << " [" << s.default_rotations << "]\n";
+    // Word-wrapped at 100 columns, indented by 6.
+    std::string_view text = s.summary;
+    while (!text.empty()) {
+      std::size_t cut = text.size();
+      if (cut > 94) {
+        cut = text.rfind(' ', 94);
+        if (cut == std::string_view::npos) cut = 94;
+      }
+      os << "      " << text.substr(0, cut) << "\n";
+      text.remove_prefix(std::min(text.size(), cut + 1));
+    }
+  }
+  os << "\nGround truth: see tools/sim/truth_writer.hpp; boxes are in the sensor frame (x forward, y left, z up).\n"
+        "Exit codes: 0 written; 1 writing failed; 2 bad command line.\n";
+}
+
+template <typename T>
+bool parse_number(std::string_view s, T& out) {
+  const auto* end = s.data() + s.size();
+  const auto [ptr, ec] = std::from_chars(s.data(), end, out);
+  return ec == std::errc{} && ptr == end;
+}
+
+struct Options {
+  std::string scene;
+  std::string pcap;
+  std::string truth;
+  std::optional<int> rotations;
+  double rate_hz = 10.0;
+  std::uint64_t seed = 1;
+  std::int64_t start_s = kDefaultStartS;
+  unsigned threads = 1;
+  bool quiet = false;
+};
+
+int bad_usage(const std::string& msg) {
+  std::cerr << "fieldguard-sim: " << msg << "\n(fieldguard-sim --help lists the options and scenes)\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string_view> args(argv + 1, argv + argc);
+  Options opt;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string_view a = args[i];
+    auto value = [&]() -> std::optional<std::string_view> {
+      if (i + 1 >= args.size()) return std::nullopt;
+      return args[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      usage(std::cout);
+      return 0;
+    }
+    if (a == "--list-scenes") {
+      for (const SceneInfo& s : scene_catalog()) std::cout << s.name << "\n";
+      return 0;
+    }
+    if (a == "--quiet") {
+      opt.quiet = true;
+      continue;
+    }
+    const auto v = value();
+    if (!v) return bad_usage(std::string(a) + " needs a value");
+    if (a == "--scene") {
+      opt.scene = *v;
+    } else if (a == "--pcap") {
+      opt.pcap = *v;
+    } else if (a == "--truth") {
+      opt.truth = *v;
+    } else if (a == "--rotations") {
+      int n = 0;
+      if (!parse_number(*v, n) || n < 1) return bad_usage("--rotations wants a whole number >= 1, not '" + std::string(*v) + "'");
+      opt.rotations = n;
+    } else if (a == "--rate") {
+      if (!parse_number(*v, opt.rate_hz) || opt.rate_hz < 5.0 || opt.rate_hz > 20.0) {
+        return bad_usage("--rate wants a number of Hz from 5 to 20 (the HDL-32E's range), not '" + std::string(*v) + "'");
+      }
+    } else if (a == "--seed") {
+      if (!parse_number(*v, opt.seed)) return bad_usage("--seed wants a whole number >= 0, not '" + std::string(*v) + "'");
+    } else if (a == "--threads") {
+      if (!parse_number(*v, opt.threads) || opt.threads > 64) return bad_usage("--threads wants 0..64, not '" + std::string(*v) + "'");
+    } else if (a == "--start-time") {
+      if (!parse_number(*v, opt.start_s) || opt.start_s < 0) {
+        return bad_usage("--start-time wants Unix seconds, not '" + std::string(*v) + "'");
+      }
+    } else {
+      return bad_usage("unknown option '" + std::string(a) + "'");
+    }
+  }
+  if (opt.scene.empty()) return bad_usage("--scene is required (--list-scenes lists them)");
+  const SceneInfo* info = find_scene(opt.scene);
+  if (info == nullptr) return bad_usage("unknown scene '" + opt.scene + "' (--list-scenes lists them)");
+  if (opt.pcap.empty()) return bad_usage("--pcap FILE is required");
+  if (opt.truth.empty()) {
+    std::string base = opt.pcap;
+    if (base.size() > 5 && base.ends_with(".pcap")) base.resize(base.size() - 5);
+    opt.truth = base + ".truth.jsonl";
+  }
+
+  SimSettings settings;
+  settings.rate_hz = opt.rate_hz;
+  settings.seed = opt.seed;
+  settings.start_time_ns = opt.start_s * 1000000000LL;
+  settings.threads = opt.threads;
+  const int rotations = opt.rotations.value_or(info->default_rotations);
+  SceneSetup setup;
+  setup.seed = opt.seed;
+  setup.rotations = rotations;
+  setup.period_s = Simulator::period_for(opt.rate_hz);
+  const auto start = std::chrono::steady_clock::now();
+  Simulator sim(*build_scene(opt.scene, setup), settings);
+
+  PcapWriter pcap;
+  if (!pcap.open(opt.pcap)) {
+    std::cerr << "fieldguard-sim: " << pcap.error() << "\n";
+    return 1;
+  }
+  std::ofstream truth(opt.truth, std::ios::binary | std::ios::trunc);
+  if (!truth) {
+    std::cerr << "fieldguard-sim: cannot create " << opt.truth << "\n";
+    return 1;
+  }
+  std::vector<TimedPacket> packets;
+  std::uint64_t points = 0;
+  std::uint64_t packet_count = 0;
+  for (int k = 0; k < rotations; ++k) {
+    packets.clear();
+    const FrameTruth t = sim.rotation(static_cast<std::uint64_t>(k), packets);
+    for (const TimedPacket& p : packets) {
+      if (!pcap.write_udp(p.bytes, p.pcap_time_ns, hdl32e::kDataPort, hdl32e::kDataPort)) {
+        std::cerr << "fieldguard-sim: " << pcap.error() << "\n";
+        return 1;
+      }
+    }
+    truth << truth_json_line(t) << '\n';
+    points += t.returns;
+    packet_count += packets.size();
+    if (!opt.quiet && (k + 1) % 100 == 0) std::cerr << "fieldguard-sim: " << (k + 1) << "/" << rotations << " rotations\n";
+  }
+  truth.close();
+  if (!truth || !pcap.close()) {
+    std::cerr << "fieldguard-sim: writing failed: " << (pcap.error().empty() ? opt.truth : pcap.error()) << "\n";
+    return 1;
+  }
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!opt.quiet) {
+    std::fprintf(stderr,
+                 "fieldguard-sim: scene %s, seed %llu: %d rotations at %.4f Hz (%d packets each), %llu packets, "
+                 "%.0f points per rotation, %.2f s (%.1f rotations/s)\n  %s\n  %s\n",
+                 opt.scene.c_str(), static_cast<unsigned long long>(opt.seed), rotations, 1.0 / sim.period_s(),
+                 sim.packets_per_rotation(), static_cast<unsigned long long>(packet_count),
+                 static_cast<double>(points) / rotations, secs, rotations / secs, opt.pcap.c_str(), opt.truth.c_str());
+  }
+  return 0;
+}

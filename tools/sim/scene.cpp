@@ -1,0 +1,60 @@
+#include "sim/scene.hpp"
+
+#include <cmath>
+
+namespace fieldguard::sim {
+
+std::string_view to_string(ObjectClass c) {
+  switch (c) {
+    case ObjectClass::Pedestrian: return "pedestrian";
+    case ObjectClass::Implement: return "implement";
+    case ObjectClass::Haystack: return "haystack";
+    case ObjectClass::House: return "house";
+    case ObjectClass::Tree: return "tree";
+    case ObjectClass::Crown: return "crown";
+    case ObjectClass::Clod: return "clod";
+    case ObjectClass::Ridge: return "ridge";
+    case ObjectClass::Crop: return "crop";
+    case ObjectClass::Body: return "body";
+  }
+  return "?";
+}
+
+bool is_terrain(ObjectClass c) {
+  return c == ObjectClass::Clod || c == ObjectClass::Ridge || c == ObjectClass::Crop || c == ObjectClass::Body;
+}
+
+SensorPose Scene::pose_at(double t_s) const {
+  const MotionParams& m = motion;
+  const double x = m.start_x_m + m.speed_mps * t_s;
+  const double ground = terrain.base(x, 0.0);
+  double roll = m.roll_deg + m.roll_amp_deg * std::sin(2.0 * kPi * t_s / m.roll_period_s);
+  double pitch = m.pitch_deg + m.pitch_amp_deg * std::sin(2.0 * kPi * t_s / m.pitch_period_s + 1.3);
+  if (m.vibration_deg != 0.0) {
+    roll += m.vibration_deg * std::sin(2.0 * kPi * 2.3 * t_s + 0.4);
+    pitch += m.vibration_deg * std::sin(2.0 * kPi * 3.1 * t_s + 2.1);
+  }
+  if (m.follow_terrain) {
+    // Rear axle 3.6 m behind the sensor, track 1.8 m: the chassis lies on the smooth ground under it.
+    const double dzdx = (terrain.base(x, 0.0) - terrain.base(x - 3.6, 0.0)) / 3.6;
+    const double dzdy = (terrain.base(x - 1.8, 0.9) - terrain.base(x - 1.8, -0.9)) / 1.8;
+    pitch -= std::atan(dzdx) / kDegToRad;  // nose up on a climb is a negative rotation about y
+    roll += std::atan(dzdy) / kDegToRad;   // left side up is a positive rotation about x
+  }
+  SensorPose pose;
+  pose.position = {x, 0.0, ground + m.sensor_height_m};
+  pose.roll_deg = roll;
+  pose.pitch_deg = pitch;
+  pose.rot = attitude(roll * kDegToRad, pitch * kDegToRad);
+  return pose;
+}
+
+void Scene::animate(double t_s) {
+  if (!pedestrian) return;
+  SceneObject& o = objects[pedestrian_index];
+  pedestrian->parts_at(t_s, terrain, o.parts);
+  o.bounds = Aabb{};
+  for (const Primitive& p : o.parts) o.bounds.add(bounds(p));
+}
+
+}  // namespace fieldguard::sim

@@ -1,0 +1,102 @@
+#pragma once
+// Runs the HDL-32E over a scene, rotation by rotation, and produces the data packets (with their pcap
+// times) and the ground truth of each rotation.
+//
+// Timing: the sensor spins at the requested rate rounded so that one rotation is a whole number of packets
+// (10 Hz -> 181 packets = 100.09 ms; 5 Hz -> 362 packets), and the first firing of the first packet is at
+// azimuth 0.00 deg: every rotation starts exactly at the 0-degree cut with block 0 of a packet. Firing
+// times follow protocols.md §1.7: block b, laser j fires 46.08 b + 1.152 j us after the packet's first
+// firing; the ray azimuth is interpolated at that time. The packet's timestamp (us past the hour) and its
+// pcap record time are both the time of its LAST firing (b = 11, j = 31), truncated to microseconds.
+// Deterministic: noise, dropouts and porous-volume depths come from a random stream per packet derived
+// from (seed, packet index), so the output is the same whatever the number of threads.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/packet_encoder.hpp"
+#include "sim/raycaster.hpp"
+#include "sim/scene.hpp"
+
+namespace fieldguard::sim {
+
+struct SimSettings {
+  double rate_hz = 10.0;
+  std::uint64_t seed = 1;
+  std::int64_t start_time_ns = 0;  // Unix time of the first firing
+  unsigned threads = 1;            // packets of a rotation cast on this many threads; the output does not
+                                   // depend on it (0 = one per hardware thread, at most 8)
+};
+
+struct TimedPacket {
+  PacketBytes bytes{};
+  std::int64_t pcap_time_ns = 0;  // whole microseconds
+};
+
+struct ObjectTruth {
+  std::string id;
+  ObjectClass cls = ObjectClass::Implement;
+  Aabb box;                  // sensor frame, when the sensor's beam swept the object's centre; for an object
+                             // across azimuth 0, the union of where it was at the rotation's start and end
+  std::uint32_t hits = 0;    // returns on it in this rotation (after dropouts)
+  double distance_m = 0.0;   // horizontal, sensor origin -> nearest point of `box`
+};
+
+struct FrameTruth {
+  std::uint64_t frame = 0;
+  std::int64_t stamp_ns = 0;  // pcap time of the rotation's first packet
+  double period_s = 0.0;
+  double roll_deg = 0.0;      // attitude at mid-rotation (R = Ry(pitch) Rx(roll), sensor -> level world)
+  double pitch_deg = 0.0;
+  Vec3 sensor_world;          // sensor position at mid-rotation (world frame)
+  std::vector<ObjectTruth> objects;  // real objects within the sensor's range, also those with no hits
+  std::vector<ObjectTruth> terrain;  // clods, ridge segments, crops and the body that have hits
+  std::uint64_t returns = 0;         // points in the rotation
+};
+
+class Simulator {
+ public:
+  Simulator(Scene scene, const SimSettings& settings);
+  Simulator(const Simulator&) = delete;  // the ray caster refers to the scene it owns
+  Simulator& operator=(const Simulator&) = delete;
+  Simulator(Simulator&&) = delete;
+  Simulator& operator=(Simulator&&) = delete;
+  ~Simulator() = default;
+
+  // The rotation period the sensor really has at a requested rate (SceneSetup::period_s wants it).
+  [[nodiscard]] static double period_for(double rate_hz);
+  [[nodiscard]] int packets_per_rotation() const { return packets_per_rotation_; }
+  [[nodiscard]] double period_s() const;
+  // Simulates rotation `k` (call with k = 0, 1, 2, ... in order): appends its packets to `out`.
+  [[nodiscard]] FrameTruth rotation(std::uint64_t k, std::vector<TimedPacket>& out);
+  [[nodiscard]] const Scene& scene() const { return scene_; }
+
+ private:
+  // What one thread gathers over its packets of a rotation.
+  struct Tally {
+    std::vector<std::uint32_t> hits;  // by ray-caster target
+    std::uint64_t returns = 0;
+    SceneObject moving;               // this thread's copy of the pedestrian
+  };
+  void prepare_bins(std::int64_t t0_ns, std::int64_t t1_ns);
+  void simulate_packet(std::uint64_t packet, std::uint64_t in_rotation, TimedPacket& out, Tally& tally) const;
+  ObjectTruth truth_of(const Aabb& world_box, std::int64_t t0_ns, const SensorPose& mid, bool moving,
+                       std::size_t index);
+  [[nodiscard]] std::int64_t absolute_ns(std::int64_t sim_ns) const { return settings_.start_time_ns + sim_ns; }
+
+  Scene scene_;
+  SimSettings settings_;
+  RayCaster caster_;
+  int packets_per_rotation_ = 181;
+  std::vector<Vec3> directions_;  // sensor-frame ray of every firing of a rotation, [block * 32 + laser]
+  std::vector<CastHit> body_;     // the tractor's body along each of them
+  std::vector<std::uint32_t> hits_;
+  std::vector<Aabb> swept_;
+  unsigned threads_ = 1;
+};
+
+// The rotation rate the sensor really runs at for a requested rate (whole packets per rotation).
+[[nodiscard]] int packets_per_rotation_for(double rate_hz);
+
+}  // namespace fieldguard::sim

@@ -1,0 +1,25 @@
+#pragma once
+// Ground truth as JSON lines, one per rotation:
+//   {"frame": k, "stamp": <pcap time of the rotation's first packet, s>, "period_s": p,
+//    "roll_deg": r, "pitch_deg": q, "sensor_world": [x, y, z], "returns": n,
+//    "objects": [{"id": "...", "class": "pedestrian|implement|haystack|house|tree|crown",
+//                 "min": [x,y,z], "max": [x,y,z], "hits": n, "distance_m": d}, ...],
+//    "terrain": [{"id": "...", "class": "clod|ridge|crop|body", "min": [...], "max": [...], "hits": n,
+//                 "distance_m": d}, ...]}
+// Boxes in the sensor frame (x forward, y left, z up, m): the axis-aligned bounds of the object's world
+// box rotated into the sensor's attitude at the moment the beam swept the object's centre (for an object
+// across azimuth 0, straight ahead, the union of its boxes at the rotation's first and last packet: the
+// rotation starts and ends there, so both are in it). distance_m is
+// the horizontal distance from the sensor origin to the nearest point of that box. "objects" lists every
+// real object within 120 m (hits may be 0: hidden or out of the beams); "terrain" only features that
+// returned points in the rotation. Keys beyond the (id, period_s, sensor_world, returns) are extras.
+
+#include <string>
+
+#include "sim/simulator.hpp"
+
+namespace fieldguard::sim {
+
+[[nodiscard]] std::string truth_json_line(const FrameTruth& truth);  // without the newline
+
+}  // namespace fieldguard::sim
