@@ -44,7 +44,7 @@ void check_gga(const nmea::Gga& g) {
   check_in(g.utc_seconds_of_day, 0.0, 86401.0);
   check_in(g.lat_deg, -90.0, 90.0);
   check_in(g.lon_deg, -180.0, 180.0);
-  check(g.quality >= 0 && g.quality <= 9);
+  if (g.quality) check(*g.quality >= 0 && *g.quality <= 9);  // empty quality field: nullopt
   if (g.satellites) check(*g.satellites >= 0);
   for (const auto& v : {g.hdop, g.alt_m, g.geoid_sep_m}) {
     if (v) check(std::isfinite(*v));

@@ -65,24 +65,30 @@ Field<double> signed_angle(std::string_view value, std::string_view hemisphere, 
 
 }  // namespace
 
-Expected<Sentence, Error> frame(std::string_view text) {
+Expected<Frame, Error> frame(std::string_view text, bool require_checksum) {
   while (!text.empty() && (text.back() == '\r' || text.back() == '\n' || text.back() == '\0')) text.remove_suffix(1);
   if (text.empty() || text.front() != '$') return Unexpected{Error::NoStart};
   if (text.size() > kMaxSentenceLength) return Unexpected{Error::TooLong};
 
   // "*hh" must end the sentence; a '*' anywhere else is a damaged checksum.
   const std::size_t star = text.rfind('*');
-  if (star == std::string_view::npos) return Unexpected{Error::NoChecksum};
-  if (star + 3 != text.size()) return Unexpected{Error::BadChecksum};
-  const auto hi = hex_digit(text[star + 1]);
-  const auto lo = hex_digit(text[star + 2]);
-  const std::string_view body = text.substr(1, star - 1);
-  if (!hi || !lo || checksum(body) != static_cast<std::uint8_t>(*hi * 16 + *lo)) return Unexpected{Error::BadChecksum};
+  std::string_view body = text.substr(1);
+  if (star == std::string_view::npos) {
+    if (require_checksum) return Unexpected{Error::NoChecksum};
+  } else {
+    if (star + 3 != text.size()) return Unexpected{Error::BadChecksum};
+    const auto hi = hex_digit(text[star + 1]);
+    const auto lo = hex_digit(text[star + 2]);
+    body = text.substr(1, star - 1);
+    if (!hi || !lo || checksum(body) != static_cast<std::uint8_t>(*hi * 16 + *lo)) {
+      return Unexpected{Error::BadChecksum};
+    }
+  }
   for (const char c : body) {
     if (!body_char_ok(c)) return Unexpected{Error::BadField};
   }
 
-  Sentence s;
+  Frame s;
   const std::size_t comma = body.find(',');
   const std::string_view address = body.substr(0, comma);
   if (address.size() == 5) {

@@ -13,14 +13,12 @@
 
 namespace fieldguard::nmea::detail {
 
-// Longest sentence accepted, from '$' to the checksum digits, line terminator excluded. The standard says
-// 82 with CR LF (80 without); real receivers exceed it (Trimble BX-960: 91-char GGA, u-blox high-precision
-// NMEA: ~90, Skytraq PSTI: 100, protocols.md §4.3). 120 keeps those and still drops two merged sentences.
-inline constexpr std::size_t kMaxSentenceLength = 120;
+// Longest sentence accepted: nmea::kMaxSentenceLength (nmea.hpp), which says why.
+using nmea::kMaxSentenceLength;
 // More fields than any sentence we decode has (RMC in NMEA 4.1: 13); the rest of a longer sentence is one field.
 inline constexpr std::size_t kMaxFields = 24;
 
-struct Sentence {
+struct Frame {
   std::string_view talker;  // "GP", "GN", ... (empty for a proprietary or odd address)
   std::string_view type;    // "RMC", "GGA", ...
   std::array<std::string_view, kMaxFields> fields{};  // fields[0] = first field after the address
@@ -31,7 +29,8 @@ struct Sentence {
 };
 
 // Checks start, length and checksum and splits the sentence. Trailing CR, LF and NUL are ignored.
-[[nodiscard]] Expected<Sentence, Error> frame(std::string_view text);
+// With require_checksum false, a sentence without "*hh" is accepted unchecked (a wrong "*hh" is still an error).
+[[nodiscard]] Expected<Frame, Error> frame(std::string_view text, bool require_checksum = true);
 
 // Field conversions. Each returns nullopt for an empty field and Error::BadField for a malformed one.
 template <typename T>
