@@ -1,6 +1,14 @@
 // Cuts decoded points into rotations at a fixed azimuth.
+//
+// Points are assembled in place: a packet's points are written at the end of the frame under construction (by
+// push(), or by a decoder through append_room()) and commit() then walks the new points once, making their times
+// frame-relative and looking for the cut. Where a packet straddles the cut, its points past the cut (at most one
+// packet's) move to the next frame's buffer. A frame's buffer is reserved with headroom over the last frame and
+// constructed once, and buffers can be recycled: a steady stream neither reallocates, nor copies a frame,
+// nor initialises points it is about to overwrite.
 #include "fieldguard/drivers/rotation_assembler.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -11,8 +19,32 @@ constexpr int kFullTurnCdeg = 36000;
 // A frame ends where the azimuth relative to the cut angle falls back by more than half a turn. Smaller
 // steps back (dual returns of one firing, per-laser azimuth corrections, jitter) never cut.
 constexpr int kWrapCdeg = kFullTurnCdeg / 2;
-// A step back across the cut angle of at most this much (just after a cut) is not progress: see push().
+// A step back across the cut angle of at most this much (just after a cut) is not progress: see commit().
 constexpr int kStepBackCdeg = 1000;
+// Headroom of a new frame's buffer over the last frame: rotations vary by a packet or two and with the scene;
+// 1/8 plus two packets' worth makes a reallocation inside a frame rare. (The last frame, not the largest ever: one
+// overlong frame, after the sensor stood still, must not size every later buffer.)
+constexpr std::size_t kHeadroomPoints = 2 * 384;
+// Recycled buffers kept at most (each one rotation's worth).
+constexpr std::size_t kMaxSpareBuffers = 2;
+
+// Points constructed at a time when a buffer needs room (128 KiB): a buffer's points are value-initialised once in
+// its life (resize() cannot leave them uninitialised), in steps of this many rather than packet by packet, and a
+// recycled buffer only where the new frame outgrows the old one.
+constexpr std::size_t kConstructStep = 4096;
+
+// Makes `v` hold at least keep + n constructed points, keeping the first `keep`.
+void make_room(std::vector<LidarPoint>& v, std::size_t keep, std::size_t n) {
+  const std::size_t need = keep + n;
+  if (v.size() >= need) return;
+  if (v.capacity() < need) {
+    std::vector<LidarPoint> bigger;
+    bigger.reserve(std::max(need, 2 * v.capacity()));
+    bigger.insert(bigger.end(), v.begin(), v.begin() + static_cast<std::ptrdiff_t>(std::min(keep, v.size())));
+    v = std::move(bigger);
+  }
+  v.resize(std::min(v.capacity(), std::max(need, v.size() + kConstructStep)));
+}
 }  // namespace
 
 RotationAssembler::RotationAssembler(double cut_deg) {
@@ -22,61 +54,141 @@ RotationAssembler::RotationAssembler(double cut_deg) {
   cut_cdeg_ = static_cast<std::uint16_t>(cdeg >= kFullTurnCdeg || cdeg < 0 ? 0 : cdeg);
 }
 
-void RotationAssembler::emit(std::vector<LidarFrame>& done, bool partial) {
+std::vector<LidarPoint> RotationAssembler::fresh_buffer() {
+  std::vector<LidarPoint> b;
+  if (!spare_.empty()) {
+    b = std::move(spare_.back());
+    spare_.pop_back();
+  }
+  const std::size_t want = last_frame_points_ + last_frame_points_ / 8 + kHeadroomPoints;
+  if (b.capacity() < want) {
+    b.clear();  // nothing to keep: reserve() need not copy the old points
+    b.reserve(want);
+  }
+  return b;
+}
+
+void RotationAssembler::emit(std::vector<LidarFrame>& done, bool partial, std::vector<LidarPoint>&& next_points) {
+  current_.points.resize(count_);  // trim the room (trivially destructible points: no work)
+  last_frame_points_ = count_;
   current_.index = next_index_++;
   current_.partial = partial;
   done.push_back(std::move(current_));
   current_ = LidarFrame{};
-  current_.points.reserve(done.back().points.size());  // the next rotation is about as large
+  current_.points = std::move(next_points);
+  count_ = 0;
   have_current_ = false;
+}
+
+std::span<LidarPoint> RotationAssembler::append_room(std::size_t n) {
+  make_room(current_.points, count_, n);
+  return {current_.points.data() + count_, n};
 }
 
 void RotationAssembler::push(std::span<const LidarPoint> points, Stamp packet_sensor_time, Stamp packet_host_time,
                              std::vector<LidarFrame>& done) {
-  bool counted = false;  // this packet already counted in the current frame
-  for (const LidarPoint& p : points) {
-    const int rel = (static_cast<int>(p.azimuth_cdeg) - static_cast<int>(cut_cdeg_) + kFullTurnCdeg) % kFullTurnCdeg;
-    if (prev_rel_cdeg_ >= 0) {
-      if (rel + kWrapCdeg < prev_rel_cdeg_) {
-        // Passed the cut angle: the frame so far is complete (or partial if it did not start at the cut).
-        if (have_current_) emit(done, !current_started_at_cut_);
-        current_started_at_cut_ = true;
-        counted = false;
-        prev_rel_cdeg_ = rel;
-      } else if (rel > prev_rel_cdeg_ + kWrapCdeg && prev_rel_cdeg_ + kFullTurnCdeg - rel <= kStepBackCdeg) {
-        // A point a little before the cut after the stream already passed it (per-laser azimuth corrections):
-        // it stays in the new frame and does not move the reference, so it cannot cause a second cut.
-      } else {
-        prev_rel_cdeg_ = rel;
-      }
-    } else {
-      prev_rel_cdeg_ = rel;
-    }
+  const std::span<LidarPoint> room = append_room(points.size());
+  std::copy(points.begin(), points.end(), room.begin());
+  commit(points.size(), packet_sensor_time, packet_host_time, done);
+}
 
-    if (!have_current_) {
-      have_current_ = true;
-      const auto offset_ns = static_cast<std::int64_t>(std::llround(static_cast<double>(p.time_s) * 1e9));
-      current_.sensor_stamp = Stamp{packet_sensor_time.ns + offset_ns};
-      current_.host_stamp = packet_host_time;
-      current_.packets = 0;
+// Azimuth relative to the cut, 0..35999: (azimuth - cut) mod 36000 for any u16 azimuth, without a division.
+inline int relative_cdeg(std::uint16_t azimuth_cdeg, int cut_cdeg) {
+  int rel = static_cast<int>(azimuth_cdeg) - cut_cdeg + kFullTurnCdeg;  // 1 .. 101535
+  rel -= kFullTurnCdeg * static_cast<int>(rel >= kFullTurnCdeg);
+  rel -= kFullTurnCdeg * static_cast<int>(rel >= kFullTurnCdeg);
+  return rel;
+}
+
+void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time,
+                               std::vector<LidarFrame>& done) {
+  std::size_t end = count_ + std::min(count, current_.points.size() - std::min(count_, current_.points.size()));
+  std::size_t i = count_;
+  bool counted = false;  // this packet already counted in the current frame
+  double packet_to_frame_s = static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
+  // Members the loops read and write, in locals (stores to the points must not make the compiler reload them).
+  const int cut = cut_cdeg_;
+  int prev = prev_rel_cdeg_;
+  bool have = have_current_;
+  while (i < end) {
+    LidarPoint* const pts = current_.points.data();
+    // Point i with every case: the first point ever, a cut, the start of a frame, the packet's first point in it.
+    {
+      LidarPoint& p = pts[i];
+      const int rel = relative_cdeg(p.azimuth_cdeg, cut);
+      if (prev >= 0) {
+        if (rel + kWrapCdeg < prev) {
+          // Passed the cut angle: the frame so far is complete (or partial if it did not start at the cut).
+          prev = rel;
+          counted = false;
+          if (have) {
+            // Points [i, end) (the rest of this packet, times still packet-relative) start the next frame; point i
+            // is then taken again as its first (no second cut: prev == rel).
+            const std::size_t tail = end - i;
+            last_frame_points_ = i;  // sizes the next buffer
+            std::vector<LidarPoint> next = fresh_buffer();
+            make_room(next, 0, tail);
+            std::copy(pts + i, pts + end, next.begin());
+            count_ = i;
+            emit(done, !current_started_at_cut_, std::move(next));
+            current_started_at_cut_ = true;
+            have = false;
+            i = 0;
+            end = tail;
+            continue;
+          }
+          current_started_at_cut_ = true;
+        } else if (rel > prev + kWrapCdeg && prev + kFullTurnCdeg - rel <= kStepBackCdeg) {
+          // A point a little before the cut after the stream already passed it (per-laser azimuth corrections):
+          // it stays in the new frame and does not move the reference, so it cannot cause a second cut.
+        } else {
+          prev = rel;
+        }
+      } else {
+        prev = rel;
+      }
+      if (!have) {
+        have = true;
+        const auto offset_ns = static_cast<std::int64_t>(std::llround(static_cast<double>(p.time_s) * 1e9));
+        current_.sensor_stamp = Stamp{packet_sensor_time.ns + offset_ns};
+        current_.host_stamp = packet_host_time;
+        current_.packets = 0;
+        packet_to_frame_s = static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
+      }
+      if (!counted) {
+        ++current_.packets;
+        counted = true;
+      }
+      p.time_s = static_cast<float>(packet_to_frame_s + static_cast<double>(p.time_s));
     }
-    if (!counted) {
-      ++current_.packets;
-      counted = true;
+    // The points after it, as long as none cuts: the frame is started and the packet counted, so all that is left
+    // is the reference azimuth and the time. A cut leaves the loop with point i untouched, for the code above.
+    for (++i; i < end; ++i) {
+      LidarPoint& p = pts[i];
+      const int rel = relative_cdeg(p.azimuth_cdeg, cut);
+      if (rel + kWrapCdeg < prev) break;
+      const bool step_back = rel > prev + kWrapCdeg && prev + kFullTurnCdeg - rel <= kStepBackCdeg;
+      prev = step_back ? prev : rel;
+      p.time_s = static_cast<float>(packet_to_frame_s + static_cast<double>(p.time_s));
     }
-    LidarPoint q = p;
-    const double packet_to_frame_s = static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
-    q.time_s = static_cast<float>(packet_to_frame_s + static_cast<double>(p.time_s));
-    current_.points.push_back(q);
   }
+  count_ = end;
+  prev_rel_cdeg_ = prev;
+  have_current_ = have;
 }
 
 void RotationAssembler::finish(std::vector<LidarFrame>& done) {
-  if (have_current_ && !current_.points.empty()) emit(done, true);
+  if (have_current_ && count_ > 0) emit(done, true, {});
   current_ = LidarFrame{};
+  count_ = 0;
   have_current_ = false;
   current_started_at_cut_ = false;
   prev_rel_cdeg_ = -1;
+}
+
+void RotationAssembler::recycle(LidarFrame&& frame) {
+  if (spare_.size() < kMaxSpareBuffers && frame.points.capacity() > 0) spare_.push_back(std::move(frame.points));
+  frame = LidarFrame{};
 }
 
 }  // namespace fieldguard

@@ -2,14 +2,34 @@
 #include "fieldguard/drivers/velodyne_decoder.hpp"
 
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "drivers/velodyne_decoder_kernels.hpp"
 
 namespace fieldguard::velodyne {
 
 namespace {
+
+using kernels::AzimuthEntry;
+using kernels::azimuth_ring_word;
+using kernels::azimuth_table;
+using kernels::load4;
+using kernels::load_le16_unchecked;
+using kernels::put_point;
+using kernels::round_cdeg;
+using kernels::round_cdeg_lround;
+using kernels::return_type_word;
+using kernels::transpose4;
+using kernels::Vec4f;
+using kernels::wrap_cdeg;
+using kernels::wrap_cdeg_fast;
 
 constexpr std::uint16_t kBlockFlag = 0xEEFF;  // FF EE on the wire, loaded little-endian
 constexpr std::uint16_t kAzimuthUnits = 36000;
@@ -50,17 +70,6 @@ bool product_contradicts(Model m, std::uint8_t product) {
     case 0xA1: return true;
     default: return false;
   }
-}
-
-float wrap_cdeg(float a) {
-  a = std::fmod(a, static_cast<float>(kAzimuthUnits));
-  if (a < 0.F) a += static_cast<float>(kAzimuthUnits);
-  return a;
-}
-
-std::uint16_t round_cdeg(float wrapped) {
-  const long r = std::lround(wrapped);
-  return static_cast<std::uint16_t>(r >= kAzimuthUnits ? r - kAzimuthUnits : r);
 }
 
 }  // namespace
@@ -111,124 +120,261 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
     throw std::invalid_argument("the calibration's distance resolution must be a positive number of metres");
   }
   if (calibration_.ring_of_laser.size() != calibration_.lasers.size()) assign_rings(calibration_);
+  resolution_m_ = static_cast<float>(calibration_.distance_resolution_m);
+  (void)azimuth_table();  // built once per process, here rather than on the first packet
+  if (options_.model == Model::Unknown) return;  // decode() refuses every packet: NoModel
 
-  table_.reserve(calibration_.lasers.size());
+  const Layout& lay = layout_of(options_.model);
+  block_us_ = lay.block_us;
+  // Summed in the same order as the point times in decode_points(), so that the marked firing is exactly 0.
+  const float in_block_last = static_cast<float>(lay.sequences - 1) * lay.sequence_us +
+                              static_cast<float>(lay.lasers - 1) * lay.firing_us;
+  last_firing_single_us_ = static_cast<float>(kBlocksPerPacket - 1) * lay.block_us + in_block_last;
+  last_firing_dual_us_ = static_cast<float>(kBlocksPerPacket / 2 - 1) * lay.block_us + in_block_last;
+
   constexpr double kRadPerDeg = std::numbers::pi / 180.0;
-  for (std::size_t i = 0; i < calibration_.lasers.size(); ++i) {
-    const LaserCorrection& c = calibration_.lasers[i];
-    const int ring = calibration_.ring_of_laser[i];
-    table_.push_back(LaserTable{
-        .cos_vert = static_cast<float>(std::cos(c.vert_deg * kRadPerDeg)),
-        .sin_vert = static_cast<float>(std::sin(c.vert_deg * kRadPerDeg)),
-        .rot_cdeg = static_cast<float>(c.rot_deg * 100.0),
-        .dist_m = static_cast<float>(c.dist_m),
-        .vert_offset_m = static_cast<float>(c.vert_offset_m),
-        .horiz_offset_m = static_cast<float>(c.horiz_offset_m),
-        .ring = static_cast<std::uint16_t>(ring < 0 ? 0 : ring),
-    });
+  for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {
+    const std::size_t s = slot / lay.lasers;  // firing sequence in the block
+    const std::size_t j = slot % lay.lasers;  // laser
+    const LaserCorrection& c = calibration_.lasers[j];
+    const int ring = calibration_.ring_of_laser[j];
+    const float in_block_us = static_cast<float>(s) * lay.sequence_us + static_cast<float>(j) * lay.firing_us;
+    slots_.cos_vert[slot] = static_cast<float>(std::cos(c.vert_deg * kRadPerDeg));
+    slots_.sin_vert[slot] = static_cast<float>(std::sin(c.vert_deg * kRadPerDeg));
+    slots_.rot_cdeg[slot] = static_cast<float>(c.rot_deg * 100.0);
+    slots_.dist_m[slot] = static_cast<float>(c.dist_m);
+    slots_.vert_offset_m[slot] = static_cast<float>(c.vert_offset_m);
+    slots_.horiz_offset_m[slot] = static_cast<float>(c.horiz_offset_m);
+    slots_.in_block_us[slot] = in_block_us;
+    slots_.block_fraction[slot] = in_block_us / lay.block_us;
+    slots_.ring[slot] = static_cast<std::uint16_t>(ring < 0 ? 0 : ring);
+    if (!(std::abs(slots_.rot_cdeg[slot]) < 35000.F)) fast_wrap_ = false;
   }
 }
 
-Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vector<LidarPoint>& out) const {
+namespace {
+
+// The returns of one block, slot by slot, and the points they make (structure of arrays: the loops over them
+// are plain arithmetic with a constant trip count, which the compiler vectorises at -O2 with baseline SSE2).
+struct BlockPoints {
+  alignas(16) std::array<std::int32_t, kSlotsPerBlock> raw;
+  alignas(16) std::array<std::int32_t, kSlotsPerBlock> intensity;
+  alignas(16) std::array<std::int32_t, kSlotsPerBlock> ok;  // 1: a return inside the range limits
+  alignas(16) std::array<float, kSlotsPerBlock> intensity_f;
+  alignas(16) std::array<float, kSlotsPerBlock> range;
+  alignas(16) std::array<float, kSlotsPerBlock> x;
+  alignas(16) std::array<float, kSlotsPerBlock> y;
+  alignas(16) std::array<float, kSlotsPerBlock> z;
+};
+
+// Azimuth, its cos/sin and the firing time of each slot of a firing group.
+struct GroupAngles {
+  alignas(16) std::array<float, kSlotsPerBlock> cos_a;
+  alignas(16) std::array<float, kSlotsPerBlock> sin_a;
+  alignas(16) std::array<float, kSlotsPerBlock> time_s;
+  alignas(16) std::array<std::uint32_t, kSlotsPerBlock> azimuth_ring;  // azimuth_ring_word() of each slot
+};
+
+}  // namespace
+
+// The per-point arithmetic is the same as the straightforward per-return loop this replaces (and gives the same
+// floats: no reassociation, no fused multiply-add at -O2 without -march), except that azimuth cos/sin come from
+// the table (see azimuth_table()). Each firing group goes through loops over its 32 slots that the compiler
+// vectorises (azimuths, ranges, coordinates), one that looks the azimuths up in the table, and one that writes the
+// points out.
+template <bool kDual, bool kFastWrap>
+std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst) const {
+  constexpr std::size_t kStep = kDual ? 2 : 1;               // blocks per firing group
+  constexpr std::size_t kGroups = kBlocksPerPacket / kStep;  // firing groups per packet
+  constexpr std::size_t kSlots = kSlotsPerBlock;
+
+  // Time of the firing the packet timestamp marks, relative to block 0 slot 0.
+  const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring
+                           ? (kDual ? last_firing_dual_us_ : last_firing_single_us_)
+                           : 0.F;
+
+  // Azimuth of each group and its step to the next group (the last group reuses the previous step).
+  std::array<int, kGroups> az_int{};
+  for (std::size_t g = 0; g < kGroups; ++g) az_int[g] = load_le16_unchecked(bytes + g * kStep * kBlockSize + 2);
+  std::array<float, kGroups> az{};
+  std::array<float, kGroups> delta{};
+  int fallback = 0;
+  for (std::size_t g = 0; g < kGroups; ++g) {
+    int d = fallback;
+    if (g + 1 < kGroups) {
+      const int raw_step = (az_int[g + 1] - az_int[g] + kAzimuthUnits) % kAzimuthUnits;
+      if (raw_step <= kMaxGroupStepCdeg) d = raw_step;
+    }
+    fallback = d;
+    az[g] = static_cast<float>(az_int[g]);
+    delta[g] = static_cast<float>(d);
+  }
+
+  const ReturnType single_type = header.return_mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
+  const float res = resolution_m_;
+  const auto min_r = static_cast<float>(options_.min_range_m);
+  const auto max_r = static_cast<float>(options_.max_range_m);
+  const AzimuthEntry* const table = azimuth_table().data();
+  const SlotTables& t = slots_;
+
+  // Azimuth of every firing of group g, its cos/sin and the firing time.
+  auto group_angles = [&](std::size_t g, GroupAngles& out) {
+    const float group_us = static_cast<float>(g) * block_us_;
+    const float az_g = az[g];
+    const float delta_g = delta[g];
+    if constexpr (kFastWrap) {
+      alignas(16) std::array<std::int32_t, kSlots> index;
+      alignas(16) std::array<float, kSlots> frac;
+      for (std::size_t s = 0; s < kSlots; ++s) {
+        const float w = wrap_cdeg_fast(az_g + delta_g * t.block_fraction[s] - t.rot_cdeg[s]);
+        const auto i = static_cast<std::int32_t>(w);  // w >= 0: truncation is floor
+        const float f = w - static_cast<float>(i);     // exact
+        index[s] = i;
+        frac[s] = f;
+        out.azimuth_ring[s] = azimuth_ring_word(round_cdeg(i, f), t.ring[s]);
+        out.time_s[s] = ((group_us + t.in_block_us[s]) - ref_us) * 1e-6F;
+      }
+      // The table look-up, four slots at a time: four entries (cos, sin, dcos, dsin) transposed into a vector of
+      // each, then entry + fraction * step (the same float operations as one slot at a time).
+      for (std::size_t s = 0; s < kSlots; s += 4) {
+        Vec4f c = load4(&table[index[s]]);
+        Vec4f sn = load4(&table[index[s + 1]]);
+        Vec4f dc = load4(&table[index[s + 2]]);
+        Vec4f ds = load4(&table[index[s + 3]]);
+        transpose4(c, sn, dc, ds);
+        const Vec4f f = load4(&frac[s]);
+        const Vec4f cos4 = c + f * dc;
+        const Vec4f sin4 = sn + f * ds;
+        std::memcpy(&out.cos_a[s], &cos4, sizeof cos4);
+        std::memcpy(&out.sin_a[s], &sin4, sizeof sin4);
+      }
+    } else {
+      // Azimuth corrections of more than 350 degrees (or not finite): the general path, as it always was.
+      for (std::size_t s = 0; s < kSlots; ++s) {
+        const float w = wrap_cdeg(az_g + delta_g * t.block_fraction[s] - t.rot_cdeg[s]);
+        const float angle = w * (std::numbers::pi_v<float> / 18000.F);
+        out.cos_a[s] = std::cos(angle);
+        out.sin_a[s] = std::sin(angle);
+        out.azimuth_ring[s] = azimuth_ring_word(round_cdeg_lround(w), t.ring[s]);
+        out.time_s[s] = ((group_us + t.in_block_us[s]) - ref_us) * 1e-6F;
+      }
+    }
+  };
+
+  // The returns of one block (kSlots of them at `b`) into points, all slots, in range or not.
+  auto block_points = [&](const std::uint8_t* b, const GroupAngles& ga, BlockPoints& out) {
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      out.raw[s] = load_le16_unchecked(b + 3 * s);
+      out.intensity[s] = b[3 * s + 2];
+    }
+    for (std::size_t s = 0; s < kSlots; ++s) {
+      const float d = static_cast<float>(out.raw[s]) * res + t.dist_m[s];
+      out.ok[s] = static_cast<std::int32_t>(out.raw[s] != 0) & static_cast<std::int32_t>(d >= min_r) &
+                  static_cast<std::int32_t>(d <= max_r);
+      const float xy = d * t.cos_vert[s] - t.vert_offset_m[s] * t.sin_vert[s];
+      out.range[s] = d;
+      out.intensity_f[s] = static_cast<float>(out.intensity[s]);
+      out.x[s] = xy * ga.cos_a[s] + t.horiz_offset_m[s] * ga.sin_a[s];
+      out.y[s] = -xy * ga.sin_a[s] + t.horiz_offset_m[s] * ga.cos_a[s];
+      out.z[s] = d * t.sin_vert[s] + t.vert_offset_m[s] * t.cos_vert[s];
+    }
+  };
+
+  // The points of four slots [s, s + 4) of block `bp` as the two 16-byte halves of each (put_point()), by two
+  // 4 x 4 transposes of the structure of arrays. `type` holds the four slots' return_type_word()s.
+  auto write4 = [&](const BlockPoints& bp, const GroupAngles& ga, std::size_t s, const Vec4f& type,
+                    std::array<Vec4f, 4>& first, std::array<Vec4f, 4>& second) {
+    first = {load4(&bp.x[s]), load4(&bp.y[s]), load4(&bp.z[s]), load4(&bp.intensity_f[s])};
+    transpose4(first[0], first[1], first[2], first[3]);
+    second = {load4(&ga.time_s[s]), load4(&bp.range[s]), load4(&ga.azimuth_ring[s]), type};
+    transpose4(second[0], second[1], second[2], second[3]);
+  };
+
+  std::size_t n = 0;
+  for (std::size_t g = 0; g < kGroups; ++g) {
+    const std::uint8_t* const block0 = bytes + g * kStep * kBlockSize + 4;
+    GroupAngles ga;
+    group_angles(g, ga);
+    BlockPoints p0;
+    block_points(block0, ga, p0);
+    std::array<Vec4f, 4> first0;
+    std::array<Vec4f, 4> second0;
+    // Every slot's point is written, in range or not, and kept (n advanced) only if in range: no branch on the data.
+    // The room holds kMaxPointsPerPacket points, and n never runs ahead of the slots written.
+    if constexpr (!kDual) {
+      const auto w = std::bit_cast<float>(return_type_word(single_type));
+      const Vec4f type = {w, w, w, w};
+      for (std::size_t s = 0; s < kSlots; s += 4) {
+        write4(p0, ga, s, type, first0, second0);
+        for (std::size_t k = 0; k < 4; ++k) {
+          put_point(dst + n, first0[k], second0[k]);
+          n += static_cast<std::size_t>(p0.ok[s + k]);
+        }
+      }
+    } else {
+      // Dual: the last return (block 0) and the strongest (block 1); one echo (both blocks equal) is emitted
+      // once, as StrongestAndLast.
+      BlockPoints p1;
+      block_points(block0 + kBlockSize, ga, p1);
+      alignas(16) std::array<std::uint32_t, kSlots> type0;
+      alignas(16) std::array<std::int32_t, kSlots> keep1;
+      for (std::size_t s = 0; s < kSlots; ++s) {
+        const bool same = p0.raw[s] == p1.raw[s] && p0.intensity[s] == p1.intensity[s];
+        type0[s] = return_type_word(same ? ReturnType::StrongestAndLast : ReturnType::Last);
+        keep1[s] = static_cast<std::int32_t>(p1.ok[s] != 0 && !same);
+      }
+      const auto w1 = std::bit_cast<float>(return_type_word(ReturnType::Strongest));
+      const Vec4f type1 = {w1, w1, w1, w1};
+      std::array<Vec4f, 4> first1;
+      std::array<Vec4f, 4> second1;
+      for (std::size_t s = 0; s < kSlots; s += 4) {
+        write4(p0, ga, s, load4(&type0[s]), first0, second0);
+        write4(p1, ga, s, type1, first1, second1);
+        for (std::size_t k = 0; k < 4; ++k) {
+          put_point(dst + n, first0[k], second0[k]);
+          n += static_cast<std::size_t>(p0.ok[s + k]);
+          put_point(dst + n, first1[k], second1[k]);
+          n += static_cast<std::size_t>(keep1[s + k]);
+        }
+      }
+    }
+  }
+  return n;
+}
+
+Expected<PacketHeader, DecodeError> Decoder::check(ByteSpan payload) const {
   auto header = read_packet_header(payload);
   if (!header) return header;
   if (options_.model == Model::Unknown) return Unexpected{DecodeError::NoModel};
   if (product_contradicts(options_.model, header->product_byte)) return Unexpected{DecodeError::ModelMismatch};
+  return header;
+}
 
-  const Layout& lay = layout_of(options_.model);
-  const bool dual = header->return_mode == ReturnMode::Dual || header->dual_layout;
-  const std::size_t step = dual ? 2 : 1;                  // blocks per firing group
-  const std::size_t groups = kBlocksPerPacket / step;     // firing groups per packet
+std::size_t Decoder::decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room) const {
+  const bool dual = header.return_mode == ReturnMode::Dual || header.dual_layout;
+  const std::uint8_t* const bytes = payload.data();  // length checked by read_packet_header()
+  if (dual) return fast_wrap_ ? decode_points<true, true>(bytes, header, room)
+                              : decode_points<true, false>(bytes, header, room);
+  return fast_wrap_ ? decode_points<false, true>(bytes, header, room) : decode_points<false, false>(bytes, header, room);
+}
 
-  // Time of the firing the packet timestamp marks, relative to block 0 slot 0.
-  // Summed in the same order as the point times below, so that the marked firing is exactly 0.
-  const float last_firing_us = static_cast<float>(groups - 1) * lay.block_us +
-                               (static_cast<float>(lay.sequences - 1) * lay.sequence_us +
-                                static_cast<float>(lay.lasers - 1) * lay.firing_us);
-  const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring ? last_firing_us : 0.F;
+Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vector<LidarPoint>& out) const {
+  auto header = check(payload);
+  if (!header) return header;
+  // Room for every return of the packet, trimmed to what was kept. resize() grows geometrically, so appending
+  // packet after packet to one vector does not reallocate per packet.
+  const std::size_t base = out.size();
+  out.resize(base + kMaxPointsPerPacket);
+  out.resize(base + decode_checked(payload, *header, out.data() + base));
+  return header;
+}
 
-  // Azimuth of each group and its step to the next group (the last group reuses the previous step).
-  std::array<float, kBlocksPerPacket> az{};
-  std::array<float, kBlocksPerPacket> delta{};
-  int fallback = 0;
-  for (std::size_t g = 0; g < groups; ++g) {
-    const int a = load_le16(payload, g * step * kBlockSize + 2);
-    az[g] = static_cast<float>(a);
-    int d = fallback;
-    if (g + 1 < groups) {
-      const int next = load_le16(payload, (g + 1) * step * kBlockSize + 2);
-      const int raw_step = (next - a + kAzimuthUnits) % kAzimuthUnits;
-      if (raw_step <= kMaxGroupStepCdeg) d = raw_step;
-    }
-    fallback = d;
-    delta[g] = static_cast<float>(d);
-  }
-
-  const ReturnType single_type =
-      header->return_mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
-  const auto res = static_cast<float>(calibration_.distance_resolution_m);
-  const auto min_r = static_cast<float>(options_.min_range_m);
-  const auto max_r = static_cast<float>(options_.max_range_m);
-  constexpr float kRadPerCdeg = std::numbers::pi_v<float> / 18000.F;
-
-  for (std::size_t g = 0; g < groups; ++g) {
-    const std::size_t block0 = g * step;
-    const float group_us = static_cast<float>(g) * lay.block_us;
-    for (std::size_t s = 0; s < lay.sequences; ++s) {
-      for (std::size_t j = 0; j < lay.lasers; ++j) {
-        const std::size_t slot = s * lay.lasers + j;
-        const LaserTable& laser = table_[j];
-        const float in_block_us = static_cast<float>(s) * lay.sequence_us + static_cast<float>(j) * lay.firing_us;
-        const float azimuth = wrap_cdeg(az[g] + delta[g] * (in_block_us / lay.block_us) - laser.rot_cdeg);
-        const float time_s = ((group_us + in_block_us) - ref_us) * 1e-6F;
-        const float angle = azimuth * kRadPerCdeg;
-        const float cos_a = std::cos(angle);
-        const float sin_a = std::sin(angle);
-
-        // Reads one return of this firing from block b; false if there is none or it is out of range.
-        auto read = [&](std::size_t b, std::uint16_t& raw, std::uint8_t& intensity) {
-          const std::size_t off = b * kBlockSize + 4 + 3 * slot;
-          raw = load_le16(payload, off);
-          intensity = payload[off + 2];
-          if (raw == 0) return false;
-          const float d = static_cast<float>(raw) * res + laser.dist_m;
-          return d >= min_r && d <= max_r;
-        };
-        auto emit = [&](std::uint16_t raw, std::uint8_t intensity, ReturnType type) {
-          const float d = static_cast<float>(raw) * res + laser.dist_m;
-          const float xy = d * laser.cos_vert - laser.vert_offset_m * laser.sin_vert;
-          LidarPoint p;
-          p.x = xy * cos_a + laser.horiz_offset_m * sin_a;
-          p.y = -xy * sin_a + laser.horiz_offset_m * cos_a;
-          p.z = d * laser.sin_vert + laser.vert_offset_m * laser.cos_vert;
-          p.intensity = static_cast<float>(intensity);
-          p.time_s = time_s;
-          p.range_m = d;
-          p.azimuth_cdeg = round_cdeg(azimuth);
-          p.ring = laser.ring;
-          p.return_type = type;
-          out.push_back(p);
-        };
-
-        std::uint16_t raw0 = 0;
-        std::uint8_t int0 = 0;
-        const bool ok0 = read(block0, raw0, int0);
-        if (!dual) {
-          if (ok0) emit(raw0, int0, single_type);
-          continue;
-        }
-        std::uint16_t raw1 = 0;
-        std::uint8_t int1 = 0;
-        const bool ok1 = read(block0 + 1, raw1, int1);
-        if (raw0 == raw1 && int0 == int1) {
-          if (ok0) emit(raw0, int0, ReturnType::StrongestAndLast);
-          continue;
-        }
-        if (ok0) emit(raw0, int0, ReturnType::Last);
-        if (ok1) emit(raw1, int1, ReturnType::Strongest);
-      }
-    }
-  }
+Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
+                                                    std::size_t& count) const {
+  count = 0;
+  auto header = check(payload);
+  if (!header) return header;
+  count = decode_checked(payload, *header, room.data());
   return header;
 }
 

@@ -37,17 +37,20 @@ void Stream::count_frames(const std::vector<LidarFrame>& done, std::size_t from)
 }
 
 void Stream::decode_one(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done) {
-  scratch_.clear();
-  const auto header = decoder_->decode(payload, scratch_);
+  // Decoded straight into the frame under construction: no copy of the points, no initialisation of their room.
+  const std::span<LidarPoint> room = assembler_.append_room(Decoder::kMaxPointsPerPacket);
+  std::size_t count = 0;
+  const auto header =
+      decoder_->decode(payload, std::span<LidarPoint, Decoder::kMaxPointsPerPacket>(room.data(), room.size()), count);
   if (!header) {
     ++counters_.errors[static_cast<std::size_t>(header.error())];
     return;
   }
   ++counters_.decoded;
-  counters_.points += scratch_.size();
+  counters_.points += count;
   const Stamp sensor = sensor_time_from_hour_offset(header->timestamp_us, host_time);
   const std::size_t before = done.size();
-  assembler_.push(scratch_, sensor, host_time, done);
+  assembler_.commit(count, sensor, host_time, done);
   count_frames(done, before);
 }
 

@@ -2,6 +2,7 @@
 // Cuts a stream of decoded points into rotations: a frame ends where the azimuth passes the cut angle.
 // One producer: not thread-safe. Push-style: frames come out as they complete.
 
+#include <cstddef>
 #include <span>
 #include <vector>
 
@@ -15,23 +16,42 @@ class RotationAssembler {
 
   // Points of one packet (time_s relative to packet_sensor_time), in firing order. Completed frames are
   // appended to `done`. Point times in an emitted frame are relative to the frame's sensor_stamp.
+  // Copies the points once; append_room() + commit() lets a decoder write them in place instead.
   void push(std::span<const LidarPoint> points, Stamp packet_sensor_time, Stamp packet_host_time,
             std::vector<LidarFrame>& done);
+
+  // In-place variant of push(), for a decoder that writes straight into the frame under construction:
+  // write one packet's points (time_s relative to the packet, as for push()) to the front of append_room(n),
+  // then commit(count, ...) the first `count` of them. Gives exactly what push() of those points gives. The room
+  // holds leftovers of earlier points, not value-initialised ones: write every field. It is valid until the next
+  // call of any other non-const member; room not committed is not part of any frame.
+  [[nodiscard]] std::span<LidarPoint> append_room(std::size_t n);
+  void commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time, std::vector<LidarFrame>& done);
 
   // End of stream: emits what is pending as a partial frame (if it holds any point).
   void finish(std::vector<LidarFrame>& done);
 
+  // Optional: hands back a frame the consumer is done with, so that its point buffer (4.4 MB for a 5 Hz
+  // HDL-32E rotation) is reused for a later frame instead of being freed, allocated and initialised again.
+  void recycle(LidarFrame&& frame);
+
   [[nodiscard]] std::uint64_t frames_emitted() const { return next_index_; }
 
  private:
-  void emit(std::vector<LidarFrame>& done, bool partial);
+  void emit(std::vector<LidarFrame>& done, bool partial, std::vector<LidarPoint>&& next_points);
+  [[nodiscard]] std::vector<LidarPoint> fresh_buffer();
 
   std::uint16_t cut_cdeg_;
+  // The frame under construction. Its points vector is kept larger than the frame (room for the next packets,
+  // constructed once per buffer): the frame's points are the first count_; emit() trims it.
   LidarFrame current_;
+  std::size_t count_ = 0;
   bool have_current_ = false;
   bool current_started_at_cut_ = false;
   int prev_rel_cdeg_ = -1;  // previous point's azimuth relative to the cut, 0..35999
   std::uint64_t next_index_ = 0;
+  std::size_t last_frame_points_ = 0;           // points of the last frame emitted (sizes the next buffer)
+  std::vector<std::vector<LidarPoint>> spare_;  // recycled point buffers
 };
 
 }  // namespace fieldguard

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fieldguard/core/bytes.hpp"
@@ -40,8 +41,12 @@ class Stream {
   // Throws std::invalid_argument when the calibration does not fit a configured model.
   explicit Stream(StreamOptions options);
 
+  // Packets are decoded straight into the frame under construction (RotationAssembler::append_room()).
   void push(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done);
   void finish(std::vector<LidarFrame>& done);
+  // Optional: hands back a frame the consumer is done with, so that its point buffer is reused for a later
+  // rotation instead of being freed and allocated again (RotationAssembler::recycle()).
+  void recycle(LidarFrame&& frame) { assembler_.recycle(std::move(frame)); }
 
   [[nodiscard]] const StreamCounters& counters() const { return counters_; }
   // The model packets are decoded as (configured, taken from the calibration, or detected).
@@ -63,7 +68,6 @@ class Stream {
   std::optional<Decoder> decoder_;
   RotationAssembler assembler_;
   std::vector<Held> held_;
-  std::vector<LidarPoint> scratch_;
   StreamCounters counters_;
 };
 

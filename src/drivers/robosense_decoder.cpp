@@ -1,0 +1,244 @@
+// RoboSense RS-32 MSOP data packet decoder (protocols.md §2.2; rs_driver decoder_RS32.hpp, block_iterator.hpp,
+// chan_angles.hpp; ros_rslidar rawdata.cc unpack_RS32 for the old 1 cm firmware; RS-LiDAR-32 manual appendix A).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "fieldguard/drivers/robosense.hpp"
+
+namespace fieldguard::robosense {
+
+namespace {
+
+constexpr std::array<std::uint8_t, 8> kMsopMagic = {0x55, 0xAA, 0x05, 0x0A, 0x5A, 0xA5, 0x50, 0xA0};
+constexpr std::size_t kTimestampOffset = 20;
+constexpr std::size_t kModelOffset = 30;
+constexpr std::size_t kTemperatureOffset = 38;
+constexpr std::uint8_t kBlockFlag0 = 0xFF;
+constexpr std::uint8_t kBlockFlag1 = 0xEE;
+constexpr int kFullTurnCdeg = 36000;
+// A step between firing groups above this (0.01 degree) is the FOV blind zone or a corrupted azimuth, not
+// rotation: rs_driver block_iterator.hpp uses the same threshold and falls back on the nominal step.
+constexpr int kMaxGroupStepCdeg = 100;
+constexpr double kHalfCmM = 0.005;
+constexpr double kOneCmM = 0.01;
+constexpr std::uint16_t kGroupFlag = 0x8000;
+
+std::size_t block_offset(std::size_t b) { return kHeaderSize + b * kBlockSize; }
+std::size_t slot_offset(std::size_t b, std::size_t slot) { return block_offset(b) + 4 + 3 * slot; }
+
+double wrap_cdeg(double a) {
+  a = std::fmod(a, static_cast<double>(kFullTurnCdeg));
+  if (a < 0.0) a += kFullTurnCdeg;
+  return a;
+}
+
+std::uint16_t round_cdeg(double wrapped) {
+  const long r = std::lround(wrapped);
+  return static_cast<std::uint16_t>(r >= kFullTurnCdeg ? r - kFullTurnCdeg : r);
+}
+
+// Temperature bytes 38..39 (rs_driver parseTempInLe; ros_rslidar computeTemperature): byte 38 bits 3..7 are the
+// low 5 bits, byte 39 bit 7 the sign and bits 0..6 the high bits; 0.0625 degC per LSB.
+float temperature_c(ByteSpan p) {
+  const int low = p[kTemperatureOffset] >> 3;
+  const int high = p[kTemperatureOffset + 1] & 0x7F;
+  const int magnitude = (high << 5) + low;
+  const bool negative = (p[kTemperatureOffset + 1] & 0x80) != 0;
+  return static_cast<float>(negative ? -magnitude : magnitude) * 0.0625F;
+}
+
+void check_calibration(const Calibration& c) {
+  for (std::size_t i = 0; i < kChannels; ++i) {
+    for (double a : {c.vert_deg[i], c.horiz_deg[i]}) {
+      if (!std::isfinite(a) || std::abs(a) >= 90.0) {
+        throw std::invalid_argument("RS-32 calibration: channel " + std::to_string(i) +
+                                    " has an angle that is not a number between -90 and 90 degrees; check the "
+                                    "configured angle table");
+      }
+    }
+  }
+}
+
+// Tables differ when an angle differs by more than half the DIFOP's resolution (0.001 degree): a configured
+// table written in degrees and the same table read from DIFOP are equal.
+bool differs(const Calibration& a, const Calibration& b) {
+  constexpr double kTolDeg = 0.0005;
+  for (std::size_t i = 0; i < kChannels; ++i) {
+    if (std::abs(a.vert_deg[i] - b.vert_deg[i]) > kTolDeg || std::abs(a.horiz_deg[i] - b.horiz_deg[i]) > kTolDeg) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+Expected<MsopHeader, DecodeError> read_msop_header(ByteSpan p) {
+  if (p.size() != kPacketSize) return Unexpected{DecodeError::BadLength};
+  if (!std::equal(kMsopMagic.begin(), kMsopMagic.end(), p.begin())) return Unexpected{DecodeError::BadMagic};
+  MsopHeader h;
+  for (std::size_t b = 0; b < kBlocksPerPacket; ++b) {
+    const std::size_t o = block_offset(b);
+    if (p[o] != kBlockFlag0 || p[o + 1] != kBlockFlag1) return Unexpected{DecodeError::BadBlockFlag};
+    h.azimuth_cdeg[b] = load_be16(p, o + 2);
+    if (h.azimuth_cdeg[b] >= kFullTurnCdeg) return Unexpected{DecodeError::BadAzimuth};
+  }
+  const auto t = decode_ymd_time(p.subspan(kTimestampOffset, 10));
+  if (!t) return Unexpected{DecodeError::BadTimestamp};
+  h.sensor_time = *t;
+  h.model_byte = p[kModelOffset];
+  h.temperature_c = temperature_c(p);
+  h.dual_layout = true;
+  for (std::size_t b = 0; b < kBlocksPerPacket; b += 2) {
+    if (h.azimuth_cdeg[b] != h.azimuth_cdeg[b + 1]) h.dual_layout = false;
+  }
+  return h;
+}
+
+Decoder::Decoder(DecoderOptions options) : options_(std::move(options)) {
+  const auto& o = options_;
+  if (!std::isfinite(o.min_range_m) || !std::isfinite(o.max_range_m) || o.min_range_m < 0.0 ||
+      o.max_range_m <= o.min_range_m) {
+    throw std::invalid_argument("RS-32 range limits: need 0 <= min_range_m < max_range_m");
+  }
+  if (!std::isfinite(o.optical_centre_offset_m) || std::abs(o.optical_centre_offset_m) > 1.0) {
+    throw std::invalid_argument("RS-32 optical centre offset must be a few centimetres (rs_driver: 0.03997 m)");
+  }
+  if (o.calibration) set_calibration(*o.calibration);
+  if (o.distance_unit == DistanceUnitOption::HalfCm) unit_ = DistanceUnit::HalfCm;
+  if (o.distance_unit == DistanceUnitOption::OneCmGrouped) unit_ = DistanceUnit::OneCmGrouped;
+  return_mode_ = o.return_mode;
+}
+
+void Decoder::set_calibration(const Calibration& c) {
+  check_calibration(c);
+  calibration_ = c;
+  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+  for (std::size_t i = 0; i < kChannels; ++i) {
+    // Ring = rank by elevation, 0 = lowest (rs_driver genUserChan); equal angles ranked by channel.
+    std::uint16_t ring = 0;
+    for (std::size_t j = 0; j < kChannels; ++j) {
+      if (c.vert_deg[j] < c.vert_deg[i] || (c.vert_deg[j] == c.vert_deg[i] && j < i)) ++ring;
+    }
+    table_[i] = Channel{.cos_vert = static_cast<float>(std::cos(c.vert_deg[i] * kRadPerDeg)),
+                        .sin_vert = static_cast<float>(std::sin(c.vert_deg[i] * kRadPerDeg)),
+                        .horiz_cdeg = static_cast<float>(c.horiz_deg[i] * 100.0),
+                        .ring = ring};
+  }
+}
+
+bool Decoder::apply(const DifopInfo& d) {
+  rpm_ = d.rpm != 0 ? d.rpm : std::uint16_t{600};
+  if (!options_.return_mode) return_mode_ = d.return_mode;
+  if (options_.distance_unit == DistanceUnitOption::Auto && !unit_) unit_ = d.distance_unit;
+  if (!d.calibration) return false;
+  if (!calibration_) {
+    set_calibration(*d.calibration);  // parse_difop checked the range, so this cannot throw
+    return false;
+  }
+  return differs(*d.calibration, *calibration_);
+}
+
+Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarPoint>& out) const {
+  auto header = read_msop_header(p);
+  if (!header) return header;
+  if (!ready()) return Unexpected{DecodeError::NoCalibration};
+
+  const ReturnMode mode = return_mode_ ? *return_mode_ : (header->dual_layout ? ReturnMode::Dual : ReturnMode::Strongest);
+  const bool dual = mode == ReturnMode::Dual;
+  const std::size_t step = dual ? 2 : 1;              // blocks per firing group
+  const std::size_t groups = kBlocksPerPacket / step;
+
+  // Azimuth of each firing group and its step to the next: the measured step when it is plausible, else the
+  // previous plausible one, else the nominal step at the DIFOP's rpm (rs_driver's BLOCK_AZ_DURATION).
+  const double nominal = static_cast<double>(kFullTurnCdeg) * (static_cast<double>(rpm_) / 60.0) * kBlockDurationUs * 1e-6;
+  std::array<double, kBlocksPerPacket> az{};
+  std::array<double, kBlocksPerPacket> delta{};
+  double fallback = nominal;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const int a = header->azimuth_cdeg[g * step];
+    az[g] = a;
+    double d = fallback;
+    if (g + 1 < groups) {
+      const int raw = (header->azimuth_cdeg[(g + 1) * step] - a + kFullTurnCdeg) % kFullTurnCdeg;
+      if (raw <= kMaxGroupStepCdeg) d = raw;
+    }
+    fallback = d;
+    delta[g] = d;
+  }
+
+  const bool grouped = *unit_ == DistanceUnit::OneCmGrouped;
+  const double unit_m = grouped ? kOneCmM : kHalfCmM;
+  const double min_r = options_.min_range_m;
+  const double max_r = options_.max_range_m;
+  const double offset_m = options_.optical_centre_offset_m;
+  const ReturnType single_type = mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
+  constexpr double kRadPerCdeg = std::numbers::pi / 18000.0;
+
+  // Raw distance of channel c in block b (slot swap and flag of the old firmware's B blocks).
+  auto raw_of = [&](std::size_t b, std::size_t c, std::uint8_t& intensity) {
+    std::size_t slot = c;
+    if (grouped && (load_be16(p, slot_offset(b, 0)) & kGroupFlag) != 0) slot = (c + kChannels / 2) % kChannels;
+    intensity = p[slot_offset(b, slot) + 2];
+    const std::uint16_t raw = load_be16(p, slot_offset(b, slot));
+    return grouped ? static_cast<std::uint16_t>(raw & ~kGroupFlag) : raw;
+  };
+
+  for (std::size_t g = 0; g < groups; ++g) {
+    for (std::size_t c = 0; c < kChannels; ++c) {
+      const Channel& ch = table_[c];
+      const double fire_us = static_cast<double>(g) * kBlockDurationUs + kFiringOffsetUs[c];
+      const double a0 = wrap_cdeg(az[g] + delta[g] * (kFiringOffsetUs[c] / kBlockDurationUs));
+      const double a = wrap_cdeg(a0 + static_cast<double>(ch.horiz_cdeg));
+      const double cos_a = std::cos(a * kRadPerCdeg);
+      const double sin_a = std::sin(a * kRadPerCdeg);
+      const double off_x = offset_m * std::cos(a0 * kRadPerCdeg);
+      const double off_y = -offset_m * std::sin(a0 * kRadPerCdeg);
+
+      auto emit = [&](std::uint16_t raw, std::uint8_t intensity, ReturnType type) {
+        const double d = static_cast<double>(raw) * unit_m;
+        const double xy = d * static_cast<double>(ch.cos_vert);
+        LidarPoint pt;
+        pt.x = static_cast<float>(xy * cos_a + off_x);
+        pt.y = static_cast<float>(-xy * sin_a + off_y);
+        pt.z = static_cast<float>(d * static_cast<double>(ch.sin_vert));
+        pt.intensity = static_cast<float>(intensity);
+        pt.time_s = static_cast<float>(fire_us * 1e-6);
+        pt.range_m = static_cast<float>(d);
+        pt.azimuth_cdeg = round_cdeg(a);
+        pt.ring = ch.ring;
+        pt.return_type = type;
+        out.push_back(pt);
+      };
+      auto valid = [&](std::uint16_t raw) {
+        const double d = static_cast<double>(raw) * unit_m;
+        return raw != 0 && d >= min_r && d <= max_r;
+      };
+
+      std::uint8_t i0 = 0;
+      const std::uint16_t r0 = raw_of(g * step, c, i0);
+      if (!dual) {
+        if (valid(r0)) emit(r0, i0, single_type);
+        continue;
+      }
+      // Dual: the first block of a pair holds the strongest return, the second the last one, or the second
+      // strongest when the strongest is also the last (manual appendix A.2 and 7.1.3): nearer = second strongest.
+      std::uint8_t i1 = 0;
+      const std::uint16_t r1 = raw_of(g * step + 1, c, i1);
+      if (r0 == r1 && i0 == i1) {
+        if (valid(r0)) emit(r0, i0, ReturnType::StrongestAndLast);
+        continue;
+      }
+      if (valid(r0)) emit(r0, i0, ReturnType::Strongest);
+      if (valid(r1)) emit(r1, i1, valid(r0) && r1 < r0 ? ReturnType::SecondStrongest : ReturnType::Last);
+    }
+  }
+  return header;
+}
+
+}  // namespace fieldguard::robosense

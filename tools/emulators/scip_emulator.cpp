@@ -1,0 +1,238 @@
+// fieldguard-scip-emulator: a TCP server that answers like a Hokuyo UTM-30LX-EW speaking SCIP 2.0, so the
+// daemon's 2D LiDAR client can be tested without the sensor. It streams MD/ME scans at 40 Hz of a simple
+// scene (a wall ahead and, optionally, a box in front of the bumper), and can misbehave on request: drop the
+// connection in the middle of a scan, send garbage, refuse to light the laser. Prints the listening port on
+// stdout, one line. Serves one client at a time, any number in turn, until --max-clients or a signal.
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "fieldguard/drivers/scip.hpp"
+
+namespace {
+
+namespace scip = fieldguard::scip;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kUsage =
+    "usage: fieldguard-scip-emulator [--port N] [--scene wall|obstacle] [--drop-after N] [--garbage-after N]\n"
+    "                                [--refuse-laser] [--max-clients N]\n"
+    "  --port N           listen on 127.0.0.1:N (default 0: any free port; the port is printed)\n"
+    "  --scene S          wall: a wall 8 m ahead; obstacle: also a 0.6 m wide box 1.0 m in front (default)\n"
+    "  --drop-after N     after N scans of a connection, send half a scan and close it (each connection)\n"
+    "  --garbage-after N  after N scans of a connection, send 300 bytes of garbage once, then go on\n"
+    "  --refuse-laser     answer BM with status 01 (laser could not be lit)\n"
+    "  --max-clients N    exit after serving N connections (default: serve until killed)\n";
+
+struct Options {
+  int port = 0;
+  bool obstacle = true;
+  long drop_after = -1;
+  long garbage_after = -1;
+  bool refuse_laser = false;
+  long max_clients = -1;
+};
+
+// A status or echo line with its check character ("00" -> "00P").
+std::string with_check(const std::string& s) { return s + scip::check_code(s) + "\n"; }
+
+// "LABEL:value;S" as the VV/PP/II replies have it: the check covers LABEL:value.
+std::string info_line(const std::string& kv) { return kv + ";" + scip::check_code(kv) + "\n"; }
+
+// Range in mm at `step` of the emulated scene.
+std::uint32_t range_mm(int step, const Options& o, std::uint32_t scan_index) {
+  const double a = (step - 540) * 0.25 * std::numbers::pi / 180.0;  // + counter-clockwise, 0 = front
+  const double c = std::cos(a);
+  double r = 60000.0;
+  if (c > 0.05) r = std::min(r, 8000.0 / c);            // the wall 8 m ahead
+  const double s = std::sin(a);
+  if (o.obstacle && c > 0.0) {                           // box face 1.0 m ahead, |y| <= 0.3 m
+    const double t = 1000.0 / c;
+    if (std::fabs(t * s) <= 300.0) r = std::min(r, t);
+  }
+  if (r >= 60000.0) return 1;                            // no echo: an error code below DMIN
+  return static_cast<std::uint32_t>(std::lround(r)) + (scan_index % 3);  // a little life in the numbers
+}
+
+std::string scan_reply(const std::string& echo, bool intensity, int first, int last, std::uint32_t index,
+                       std::uint32_t time_ms, const Options& o) {
+  std::string out = echo + "\n" + with_check("99");
+  std::string ts;
+  scip::encode_chars(time_ms & 0xFFFFFFU, 4, ts);
+  out += with_check(ts);
+  std::string data;
+  for (int step = first; step <= last; ++step) {
+    scip::encode_chars(range_mm(step, o, index), 3, data);
+    if (intensity) scip::encode_chars(1000 + static_cast<std::uint32_t>(step), 3, data);
+  }
+  for (std::size_t i = 0; i < data.size(); i += scip::kDataCharsPerLine) out += with_check(data.substr(i, scip::kDataCharsPerLine));
+  return out + "\n";
+}
+
+bool send_all(int fd, const std::string& s) {
+  std::size_t done = 0;
+  while (done < s.size()) {
+    const ssize_t n = ::send(fd, s.data() + done, s.size() - done, MSG_NOSIGNAL);
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+void serve(int fd, const Options& o) {
+  std::string pending;
+  bool laser = false;
+  bool streaming = false;
+  bool intensity = false;
+  int first = 0;
+  int last = 1080;
+  std::string stream_echo;
+  std::uint32_t scans = 0;
+  bool garbage_sent = false;
+  const auto t0 = Clock::now();
+  auto next_scan = t0;
+  for (;;) {
+    pollfd p{fd, POLLIN, 0};
+    const auto wait = streaming ? std::chrono::duration_cast<std::chrono::milliseconds>(next_scan - Clock::now()).count() : 1000;
+    const int r = ::poll(&p, 1, static_cast<int>(std::max<long long>(0, wait)));
+    if (r < 0) return;
+    if (r > 0) {
+      char buf[512];
+      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+      if (n <= 0) return;
+      pending.append(buf, static_cast<std::size_t>(n));
+      std::size_t nl = 0;
+      while ((nl = pending.find_first_of("\r\n")) != std::string::npos) {
+        std::string line = pending.substr(0, nl);
+        pending.erase(0, nl + 1);
+        if (line.empty()) continue;
+        const std::string cmd = line.substr(0, std::min<std::size_t>(2, line.size()));
+        std::string reply = line + "\n";
+        if (line.rfind("SCIP2.0", 0) == 0) {
+          reply += with_check("00") + "\n";
+        } else if (cmd == "VV") {
+          reply += with_check("00") + info_line("VEND:Hokuyo Automatic Co.,Ltd.") + info_line("PROD:SOKUIKI Sensor UTM-30LX-EW") +
+                   info_line("FIRM:1.1.3(fieldguard emulator)") + info_line("PROT:SCIP 2.0") + info_line("SERI:H0000000") + "\n";
+        } else if (cmd == "PP") {
+          reply += with_check("00") + info_line("MODL:UTM-30LX-EW") + info_line("DMIN:23") + info_line("DMAX:60000") +
+                   info_line("ARES:1440") + info_line("AMIN:0") + info_line("AMAX:1080") + info_line("AFRT:540") +
+                   info_line("SCAN:2400") + "\n";
+        } else if (cmd == "II") {
+          reply += with_check("00") + info_line("MODL:UTM-30LX-EW") + info_line(laser ? "LASR:ON" : "LASR:OFF") +
+                   info_line("SCSP:2400") + info_line("MESM:Measuring by Sensitive Mode") + info_line("SBPS:Ethernet 100 [Mbps]") +
+                   info_line("TIME:000000") + info_line("STAT:Stable 000 no error.") + "\n";
+        } else if (cmd == "BM") {
+          if (o.refuse_laser) reply += with_check("01") + "\n";
+          else {
+            reply += with_check(laser ? "02" : "00") + "\n";
+            laser = true;
+          }
+        } else if ((cmd == "MD" || cmd == "ME") && line.size() >= 15) {
+          first = std::atoi(line.substr(2, 4).c_str());
+          last = std::atoi(line.substr(6, 4).c_str());
+          if (first > last || last > 1080) {
+            reply += with_check("04") + "\n";
+          } else {
+            reply += with_check("00") + "\n";
+            laser = true;
+            streaming = true;
+            intensity = cmd == "ME";
+            stream_echo = line;
+            next_scan = Clock::now() + std::chrono::milliseconds(25);
+          }
+        } else if (cmd == "QT" || cmd == "RS") {
+          streaming = false;
+          laser = false;
+          reply += with_check("00") + "\n";
+        } else {
+          reply += with_check("0E") + "\n";
+        }
+        if (!send_all(fd, reply)) return;
+      }
+      if (pending.size() > 4096) return;  // a client that sends no line ends: not a SCIP client
+    }
+    if (streaming && Clock::now() >= next_scan) {
+      next_scan += std::chrono::milliseconds(25);
+      const auto ms = static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count());
+      const std::string s = scan_reply(stream_echo, intensity, first, last, scans, ms, o);
+      if (o.drop_after >= 0 && scans >= static_cast<std::uint32_t>(o.drop_after)) {
+        send_all(fd, s.substr(0, s.size() / 2));
+        return;  // the caller closes the socket in the middle of the scan
+      }
+      if (o.garbage_after >= 0 && !garbage_sent && scans >= static_cast<std::uint32_t>(o.garbage_after)) {
+        std::string junk;
+        for (int i = 0; i < 300; ++i) junk += static_cast<char>((i * 37 + 11) % 251);
+        if (!send_all(fd, junk)) return;
+        garbage_sent = true;
+      }
+      if (!send_all(fd, s)) return;
+      ++scans;
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n%s", a.c_str(), kUsage);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--port") o.port = std::atoi(value().c_str());
+    else if (a == "--scene") o.obstacle = value() != "wall";
+    else if (a == "--drop-after") o.drop_after = std::atol(value().c_str());
+    else if (a == "--garbage-after") o.garbage_after = std::atol(value().c_str());
+    else if (a == "--refuse-laser") o.refuse_laser = true;
+    else if (a == "--max-clients") o.max_clients = std::atol(value().c_str());
+    else if (a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else {
+      std::fprintf(stderr, "unknown option %s\n%s", a.c_str(), kUsage);
+      return 2;
+    }
+  }
+  const int srv = ::socket(AF_INET, SOCK_STREAM, 0);
+  const int on = 1;
+  ::setsockopt(srv, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(o.port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::bind(srv, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 || ::listen(srv, 4) != 0) {
+    std::fprintf(stderr, "fieldguard-scip-emulator: cannot listen on 127.0.0.1:%d: %s\n", o.port, std::strerror(errno));
+    return 2;
+  }
+  socklen_t len = sizeof addr;
+  ::getsockname(srv, reinterpret_cast<sockaddr*>(&addr), &len);
+  std::printf("%u\n", ntohs(addr.sin_port));
+  std::fflush(stdout);
+  for (long served = 0; o.max_clients < 0 || served < o.max_clients; ++served) {
+    const int fd = ::accept(srv, nullptr, nullptr);
+    if (fd < 0) continue;
+    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
+    serve(fd, o);
+    ::close(fd);
+  }
+  ::close(srv);
+  return 0;
+}
