@@ -2,13 +2,16 @@
 
 #include <vector>
 
+#include <chrono>
+
 #include "fieldguard/drivers/scip.hpp"
+#include "fieldguard/drivers/scip_session.hpp"
 
 namespace fieldguard::io {
 
 struct ScipSource::Impl {
   Impl(boost::asio::io_context& io, ScipSourceOptions o, ScanHandler s, StateHandler st)
-      : options(std::move(o)), on_scan(std::move(s)), on_state(std::move(st)), client(options.client),
+      : options(std::move(o)), on_scan(std::move(s)), on_state(std::move(st)), session(options.client),
         link(io, options.tcp,
              {.on_connected = [this] { connected(); },
               .on_data = [this](ByteSpan b, Stamp t) { data(b, t); },
@@ -17,56 +20,54 @@ struct ScipSource::Impl {
   ScipSourceOptions options;
   ScanHandler on_scan;
   StateHandler on_state;
+  TapHandler tap;
   ScipSourceStats stats;
-  scip::ReplyParser parser;
-  scip::Client client;
-  std::uint64_t parser_errors_at_connect = 0;
-  std::vector<scip::Reply> replies;
+  scip::Session session;
   TcpClient link;  // last: its handlers use the members above
 
   void say(const std::string& s) const {
     if (on_state) on_state(s);
   }
 
-  void connected() {
-    parser.reset();
-    client = scip::Client(options.client);
-    parser_errors_at_connect = parser.counters().rejected();
-    counted_errors_ = 0;
-    link.send(client.start());
+  void send(const std::string& bytes) {
+    if (bytes.empty()) return;
+    if (tap) tap(ByteSpan(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size()), true, now());
+    link.send(bytes);
   }
+
+  static Stamp now() {
+    return Stamp{std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+                     .count()};
+  }
+
+  void connected() { send(session.connect()); }
 
   void data(ByteSpan bytes, Stamp t) {
-    replies.clear();
-    parser.push(bytes, replies);
-    const std::uint64_t errors = parser.counters().rejected() - parser_errors_at_connect;
-    stats.parser_errors = stats.parser_errors.load() + (errors - std::min(errors, counted_errors_));
-    counted_errors_ = errors;
-    for (const auto& r : replies) {
-      scip::ClientEvent ev = client.on_reply(r);
-      if (ev.error) ++stats.decode_errors;
-      if (ev.sensor_status) {
-        ++stats.sensor_trouble;
-        say("2D LiDAR reports status " + *ev.sensor_status);
-      }
-      if (ev.refused) {
-        ++stats.refusals;
-        link.reconnect("2D LiDAR refused " + std::string(scip::to_string(ev.refused->command)) + " with status " +
-                       ev.refused->status + " (" + std::string(ev.refused->text) + ")");
-        return;
-      }
-      if (!ev.send.empty()) link.send(ev.send);
-      if (ev.scan) {
-        ++stats.scans;
-        if (on_scan) on_scan(*ev.scan, client.geometry(), t);
-      }
+    if (tap) tap(bytes, false, t);
+    scip::SessionEvents ev = session.on_bytes(bytes);
+    stats.parser_errors += ev.parser_errors;
+    stats.decode_errors += ev.decode_errors;
+    for (const auto& st : ev.sensor_status) {
+      ++stats.sensor_trouble;
+      say("2D LiDAR reports status " + st);
     }
-    if (errors > options.max_parser_errors) {
-      link.reconnect("2D LiDAR stream unreadable: " + std::to_string(errors) + " framing errors on this connection");
+    for (const auto& s : ev.scans) {
+      ++stats.scans;
+      if (on_scan) on_scan(s, session.client().geometry(), t);
+    }
+    if (!ev.refusals.empty()) {
+      const auto& r = ev.refusals.front();
+      ++stats.refusals;
+      link.reconnect("2D LiDAR refused " + std::string(scip::to_string(r.command)) + " with status " + r.status +
+                     " (" + std::string(r.text) + ")");
+      return;
+    }
+    send(ev.send);
+    if (session.parser_errors_this_connection() > options.max_parser_errors) {
+      link.reconnect("2D LiDAR stream unreadable: " + std::to_string(session.parser_errors_this_connection()) +
+                     " framing errors on this connection");
     }
   }
-
-  std::uint64_t counted_errors_ = 0;
 };
 
 ScipSource::ScipSource(boost::asio::io_context& io, ScipSourceOptions options, ScanHandler on_scan,
@@ -81,6 +82,7 @@ void ScipSource::stop() { impl_->link.stop(); }
 
 const ScipSourceStats& ScipSource::stats() const { return impl_->stats; }
 const TcpClientStats& ScipSource::link() const { return impl_->link.stats(); }
-scip::ClientState ScipSource::protocol_state() const { return impl_->client.state(); }
+scip::ClientState ScipSource::protocol_state() const { return impl_->session.client().state(); }
+void ScipSource::set_tap(TapHandler tap) { impl_->tap = std::move(tap); }
 
 }  // namespace fieldguard::io

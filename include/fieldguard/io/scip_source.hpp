@@ -42,6 +42,10 @@ class ScipSource {
   ScipSource(const ScipSource&) = delete;
   ScipSource& operator=(const ScipSource&) = delete;
 
+  // Every byte of the conversation as it passes, for recording: to_sensor false = from the sensor.
+  using TapHandler = std::function<void(ByteSpan bytes, bool to_sensor, Stamp time)>;
+  void set_tap(TapHandler tap);
+
   void start();
   void stop();  // closes the connection: the sensor stops streaming when its client goes
 
