@@ -46,6 +46,11 @@ class JsonLine {
   JsonLine& field(std::string_view k, const std::optional<T>& v) {
     return v ? field(k, *v) : null(k);
   }
+  JsonLine& boolean(std::string_view k, bool v) {
+    key(k);
+    s_ += v ? "true" : "false";
+    return *this;
+  }
   // A one-letter code ('A', 'D', ...) as a string; null for 0 (absent).
   JsonLine& letter(std::string_view k, char c) { return c == 0 ? null(k) : field(k, std::string_view(&c, 1)); }
   JsonLine& array(std::string_view k, std::span<const double> v) {

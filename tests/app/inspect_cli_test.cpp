@@ -69,11 +69,18 @@ TEST(InspectCli, UnusableFilesExitTwo) {
   EXPECT_EQ(u.exit_code, 2);
   EXPECT_NE(u.output.find("cannot tell the format"), std::string::npos) << u.output;
 
-  // A pcap is a LiDAR capture: recognised, not inspected yet.
-  const TempFile pcap("pcap", bytes({0xD4, 0xC3, 0xB2, 0xA1, 2, 0, 4, 0}) + std::string(16, '\0'));
+  // A pcap cut inside its file header is unusable; one with a header and no records is read: nothing in it.
+  const TempFile cut("cut_pcap", bytes({0xD4, 0xC3, 0xB2, 0xA1, 2, 0, 4, 0}));
+  const auto c = run_fieldguard("inspect " + cut.arg());
+  EXPECT_EQ(c.exit_code, 2);
+  EXPECT_NE(c.output.find("cut short"), std::string::npos) << c.output;
+  const TempFile pcap("pcap", bytes({0xD4, 0xC3, 0xB2, 0xA1, 2, 0, 4, 0}) + std::string(8, '\0') +
+                                  bytes({0xFF, 0xFF, 0, 0, 1, 0, 0, 0}));  // snaplen 65535, Ethernet
   const auto p = run_fieldguard("inspect " + pcap.arg());
-  EXPECT_EQ(p.exit_code, 2);
-  EXPECT_NE(p.output.find("not yet supported"), std::string::npos) << p.output;
+  EXPECT_EQ(p.exit_code, 0) << p.output;
+  EXPECT_NE(p.output.find("velodyne (guessed)"), std::string::npos) << p.output;
+  EXPECT_EQ(summary_number(p.output, "records"), 0);
+  EXPECT_EQ(summary_number(p.output, "pcap_records"), 0);
 }
 
 TEST(InspectCli, NmeaRecordsCarryTheDocumentedKeys) {
