@@ -2,26 +2,22 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
+#include <type_traits>
+#include <vector>
 
+#include "app/config_sensors.hpp"
 #include "app/yaml_reader.hpp"
 
 namespace fieldguard::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-void read_mounting(YamlReader& r, const YAML::Node& n, const std::string& path, Mounting& m) {
-  if (!r.section(n, path, {"x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"})) return;
-  r.number(n, path, "x_m", m.x_m, -20.0, 20.0, "m");
-  r.number(n, path, "y_m", m.y_m, -20.0, 20.0, "m");
-  r.number(n, path, "z_m", m.z_m, -5.0, 10.0, "m");
-  r.number(n, path, "roll_deg", m.roll_deg, -180.0, 180.0, "degrees");
-  r.number(n, path, "pitch_deg", m.pitch_deg, -90.0, 90.0, "degrees");
-  r.number(n, path, "yaw_deg", m.yaw_deg, -180.0, 180.0, "degrees");
-}
 
 std::string read_text_file(const fs::path& p, std::string& error) {
   std::error_code ec;
@@ -114,13 +110,181 @@ void read_box(YamlReader& r, const YAML::Node& n, const std::string& path, perce
   }
 }
 
+// Lists of numbers, each item checked like YamlReader::number / integer. `out` is left alone unless every
+// item is good; each bad item is its own issue, with its line and path ("...edges_m[2]").
+template <class T>
+bool list_of(YamlReader& r, const YAML::Node& map, const std::string& path, const char* key, std::vector<T>& out, T lo,
+             T hi, const char* what, std::size_t min_items, std::size_t max_items) {
+  if (!map.IsMap() || !map[key]) return true;
+  const std::string p = join_path(path, key);
+  const YAML::Node v = map[key];
+  if (!v.IsSequence() || v.size() < min_items || v.size() > max_items) {
+    r.issue(v, p,
+            "expected a list of " + std::to_string(min_items) + " to " + std::to_string(max_items) + " " + what +
+                (v.IsSequence() ? ", got " + std::to_string(v.size()) : ""));
+    return false;
+  }
+  std::vector<T> items;
+  bool good = true;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::string ip = p + "[" + std::to_string(i) + "]";
+    const std::string text = v[i].IsScalar() ? v[i].Scalar() : std::string();
+    T value{};
+    const char* end = text.data() + text.size();
+    const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+    if (!v[i].IsScalar() || ec != std::errc() || ptr != end || !std::isfinite(static_cast<double>(value))) {
+      r.issue(
+          v[i], ip,
+          std::string("expected ") + (std::is_integral_v<T> ? "a whole number" : "a number") + ", got '" + text + "'");
+      good = false;
+    } else if (value < lo || value > hi) {
+      std::ostringstream m;
+      m << value << " is out of range; use a value from " << lo << " to " << hi;
+      r.issue(v[i], ip, m.str());
+      good = false;
+    }
+    items.push_back(value);
+  }
+  if (good) out = std::move(items);
+  return good;
+}
+
+YAML::Node value_or(const YAML::Node& map, const char* key) { return map[key] ? map[key] : map; }
+
+void read_voxel(YamlReader& r, const YAML::Node& v, perception::VoxelParams& p) {
+  const std::string path = "perception.voxel";
+  if (!r.section(v, path, {"leaf_m", "coarse_from_m", "max_leaf_m"})) return;
+  r.number(v, path, "leaf_m", p.leaf_m, 0.01, 2.0, "m");
+  r.number(v, path, "coarse_from_m", p.coarse_from_m, 0.0, 500.0, "m");
+  r.number(v, path, "max_leaf_m", p.max_leaf_m, 0.01, 5.0, "m");
+  if (p.coarse_from_m > 0.0) {
+    if (p.max_leaf_m < p.leaf_m) {
+      r.issue(v["max_leaf_m"] ? v["max_leaf_m"] : v, path + ".max_leaf_m",
+              "must not be less than leaf_m when coarse_from_m is set; the leaf only grows with range");
+    } else if (p.max_leaf_m > 15.0 * p.leaf_m) {
+      r.issue(v["max_leaf_m"] ? v["max_leaf_m"] : v, path + ".max_leaf_m",
+              "must be at most 15 times leaf_m (the leaf grows in at most 15 whole-multiple bands)");
+    }
+  }
+}
+
+void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
+  const std::string path = "perception.ground.zones";
+  if (!r.section(z, path,
+                 {"edges_m", "rings", "sectors", "min_bin_points", "seed_lowest", "seed_margin_m", "fit_distance_m",
+                  "fit_iterations", "ground_threshold_m", "max_slope_deg", "max_tilt_deg", "max_step_m",
+                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m"})) {
+    return;
+  }
+  // The lists are checked against each other only when each was read (a bad list has its own issue).
+  const bool edges_ok = list_of(r, z, path, "edges_m", p.edges_m, 0.0, 500.0, "numbers (m)", 2, 17);
+  const bool rings_ok = list_of(r, z, path, "rings", p.rings, 1, 64, "whole numbers", 1, 16);
+  const bool sectors_ok = list_of(r, z, path, "sectors", p.sectors, 1, 720, "whole numbers", 1, 16);
+  r.integer(z, path, "min_bin_points", p.min_bin_points, 3, 100000);
+  r.integer(z, path, "seed_lowest", p.seed_lowest, 1, 100000);
+  r.number(z, path, "seed_margin_m", p.seed_margin_m, 0.0, 5.0, "m");
+  r.number(z, path, "fit_distance_m", p.fit_distance_m, 0.01, 5.0, "m");
+  r.integer(z, path, "fit_iterations", p.fit_iterations, 0, 100);
+  r.number(z, path, "ground_threshold_m", p.ground_threshold_m, 0.01, 5.0, "m");
+  r.number(z, path, "max_slope_deg", p.max_slope_deg, 0.0, 80.0, "degrees");
+  r.number(z, path, "max_tilt_deg", p.max_tilt_deg, 0.0, 45.0, "degrees");
+  r.number(z, path, "max_step_m", p.max_step_m, 0.0, 10.0, "m");
+  r.number(z, path, "max_slope_change_deg", p.max_slope_change_deg, 0.0, 80.0, "degrees");
+  r.number(z, path, "min_spread_m", p.min_spread_m, 0.0, 100.0, "m");
+  r.number(z, path, "max_extrapolation_m", p.max_extrapolation_m, 0.0, 500.0, "m");
+  for (std::size_t i = 1; i < p.edges_m.size(); ++i) {
+    if (!(p.edges_m[i] > p.edges_m[i - 1])) {
+      r.issue(value_or(z, "edges_m"), path + ".edges_m", "zone edges must increase from the sensor outwards");
+      break;
+    }
+  }
+  if (!edges_ok) return;
+  const std::size_t zones = p.edges_m.size() - 1;
+  if (rings_ok && p.rings.size() != zones) {
+    r.issue(value_or(z, "rings"), path + ".rings",
+            "needs one ring count per zone: " + std::to_string(zones) + " (one fewer than edges_m)");
+  }
+  if (sectors_ok && p.sectors.size() != zones) {
+    r.issue(value_or(z, "sectors"), path + ".sectors",
+            "needs one sector count per zone: " + std::to_string(zones) + " (one fewer than edges_m)");
+  }
+}
+
+void read_ground(YamlReader& r, const YAML::Node& g, perception::GroundParams& p) {
+  const std::string path = "perception.ground";
+  if (!r.section(g, path, {"method", "ransac", "zones"})) return;
+  if (auto m = r.choice(g, path, "method", {"ransac", "zones"})) {
+    p.method = *m == 0 ? perception::GroundMethod::Ransac : perception::GroundMethod::Zones;
+  }
+  const YAML::Node rs = g["ransac"];
+  const std::string rp = path + ".ransac";
+  if (r.section(rs, rp, {"iterations", "distance_m", "seed"})) {
+    r.integer(rs, rp, "iterations", p.ransac.iterations, 1, 100000);
+    r.number(rs, rp, "distance_m", p.ransac.distance_m, 0.001, 5.0, "m");
+    int seed = static_cast<int>(p.ransac.seed);
+    r.integer(rs, rp, "seed", seed, 0, 2147483647);
+    p.ransac.seed = static_cast<std::uint32_t>(seed);
+  }
+  read_zones(r, g["zones"], p.zones);
+}
+
+void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams& p) {
+  const std::string path = "perception.cluster";
+  if (!r.section(c, path,
+                 {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m"})) {
+    return;
+  }
+  if (auto m = r.choice(c, path, "method", {"fixed", "adaptive"})) {
+    p.method = *m == 0 ? perception::ClusterMethod::Fixed : perception::ClusterMethod::Adaptive;
+  }
+  if (auto s = r.choice(c, path, "structure", {"kdtree", "grid"})) {
+    p.structure = *s == 0 ? perception::ClusterStructure::KdTree : perception::ClusterStructure::Grid;
+  }
+  r.number(c, path, "tolerance_m", p.tolerance_m, 0.01, 10.0, "m");
+  r.number(c, path, "beam_spacing_deg", p.beam_spacing_deg, 0.01, 10.0, "degrees");
+  r.number(c, path, "beam_factor", p.beam_factor, 0.0, 10.0, "");
+  r.number(c, path, "max_tolerance_m", p.max_tolerance_m, 0.01, 10.0, "m");
+  if (p.method == perception::ClusterMethod::Adaptive) {
+    if (p.max_tolerance_m < p.tolerance_m) {
+      r.issue(value_or(c, "max_tolerance_m"), path + ".max_tolerance_m",
+              "must not be less than tolerance_m; the adaptive radius grows from tolerance_m up to it");
+    }
+    if (p.beam_factor * std::tan(p.beam_spacing_deg * std::numbers::pi / 180.0) >= 0.5) {
+      r.issue(value_or(c, "beam_factor"), path + ".beam_factor",
+              "beam_factor * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a metre per "
+              "metre of range); lower beam_factor");
+    }
+  }
+}
+
+void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& p) {
+  const std::string fp = "perception.filters";
+  if (!r.section(f, fp,
+                 {"min_points", "max_points", "min_volume_m3", "max_volume_m3", "min_height_m",
+                  "min_points_full_range_m", "min_points_floor"})) {
+    return;
+  }
+  r.integer(f, fp, "min_points", p.min_points, 1, 10000000);
+  r.integer(f, fp, "max_points", p.max_points, 0, 10000000);
+  r.number(f, fp, "min_volume_m3", p.min_volume_m3, 0.0, 1e6, "m^3");
+  r.number(f, fp, "max_volume_m3", p.max_volume_m3, 0.0, 1e6, "m^3");
+  r.number(f, fp, "min_height_m", p.min_height_m, 0.0, 10.0, "m");
+  r.number(f, fp, "min_points_full_range_m", p.min_points_full_range_m, 0.0, 500.0, "m");
+  r.integer(f, fp, "min_points_floor", p.min_points_floor, 1, 10000000);
+  if (p.max_points > 0 && p.min_points > p.max_points) {
+    r.issue(value_or(f, "max_points"), fp + ".max_points", "must not be less than min_points (0 = no upper limit)");
+  }
+  if (p.max_volume_m3 > 0.0 && p.min_volume_m3 > p.max_volume_m3) {
+    r.issue(value_or(f, "max_volume_m3"), fp + ".max_volume_m3",
+            "must not be less than min_volume_m3 (0 = no upper limit)");
+  }
+}
+
 void read_perception(YamlReader& r, const YAML::Node& n, perception::PipelineParams& p) {
   const std::string path = "perception";
   if (!r.section(n, path, {"voxel", "roi", "body", "ground", "cluster", "filters"})) return;
 
-  if (r.section(n["voxel"], "perception.voxel", {"leaf_m"})) {
-    r.number(n["voxel"], "perception.voxel", "leaf_m", p.voxel.leaf_m, 0.01, 2.0, "m");
-  }
+  read_voxel(r, n["voxel"], p.voxel);
   read_box(r, n["roi"], "perception.roi", p.roi);
   read_box(r, n["body"], "perception.body", p.body);
   if (n["roi"] && n["body"] && !p.roi.contains(p.body)) {
@@ -128,41 +292,9 @@ void read_perception(YamlReader& r, const YAML::Node& n, perception::PipelinePar
             "the tractor body box reaches outside perception.roi; shrink the body box or grow the ROI so that the "
             "body lies inside it");
   }
-
-  const YAML::Node g = n["ground"];
-  if (r.section(g, "perception.ground", {"method", "ransac"})) {
-    if (auto m = r.choice(g, "perception.ground", "method", {"ransac"})) {
-      p.ground.method = perception::GroundMethod::Ransac;
-      (void)m;
-    }
-    const YAML::Node rs = g["ransac"];
-    if (r.section(rs, "perception.ground.ransac", {"iterations", "distance_m", "seed"})) {
-      r.integer(rs, "perception.ground.ransac", "iterations", p.ground.ransac.iterations, 1, 100000);
-      r.number(rs, "perception.ground.ransac", "distance_m", p.ground.ransac.distance_m, 0.001, 5.0, "m");
-      int seed = static_cast<int>(p.ground.ransac.seed);
-      r.integer(rs, "perception.ground.ransac", "seed", seed, 0, 2147483647);
-      p.ground.ransac.seed = static_cast<std::uint32_t>(seed);
-    }
-  }
-
-  if (r.section(n["cluster"], "perception.cluster", {"tolerance_m"})) {
-    r.number(n["cluster"], "perception.cluster", "tolerance_m", p.cluster.tolerance_m, 0.01, 10.0, "m");
-  }
-
-  const YAML::Node f = n["filters"];
-  const std::string fp = "perception.filters";
-  if (r.section(f, fp, {"min_points", "max_points", "min_volume_m3", "max_volume_m3"})) {
-    r.integer(f, fp, "min_points", p.filters.min_points, 1, 10000000);
-    r.integer(f, fp, "max_points", p.filters.max_points, 1, 10000000);
-    r.number(f, fp, "min_volume_m3", p.filters.min_volume_m3, 0.0, 1e6, "m^3");
-    r.number(f, fp, "max_volume_m3", p.filters.max_volume_m3, 0.0, 1e6, "m^3");
-    if (p.filters.min_points > p.filters.max_points) {
-      r.issue(f["max_points"] ? f["max_points"] : f, fp + ".max_points", "must not be less than min_points");
-    }
-    if (p.filters.min_volume_m3 > p.filters.max_volume_m3) {
-      r.issue(f["max_volume_m3"] ? f["max_volume_m3"] : f, fp + ".max_volume_m3", "must not be less than min_volume_m3");
-    }
-  }
+  read_ground(r, n["ground"], p.ground);
+  read_cluster(r, n["cluster"], p.cluster);
+  read_filters(r, n["filters"], p.filters);
 }
 
 LoadResult load(const std::string& text, const std::string& name, const std::string& config_dir) {
@@ -181,9 +313,25 @@ LoadResult load(const std::string& text, const std::string& name, const std::str
     result.issues.push_back({name, 0, "", "the file is empty; start from config/fieldguard.yaml"});
     return result;
   }
-  if (r.section(root, "", {"lidar", "perception"})) {
+  if (r.section(root, "", {"lidar", "scan2d", "gnss", "ahrs", "perception"})) {
     read_lidar(r, root["lidar"], config_dir, result.config.lidar);
+    read_scan2d(r, root["scan2d"], result.config.scan2d);
+    read_gnss(r, root["gnss"], result.config.gnss);
+    read_ahrs(r, root["ahrs"], result.config.ahrs);
     read_perception(r, root["perception"], result.config.perception);
+    // The zone ground starts from the ground below the sensor: the LiDAR's mounting height when the file
+    // gives one (otherwise ZoneParams' default, 0.95 m).
+    auto& cfg = result.config;
+    const YAML::Node lidar = root["lidar"];
+    const YAML::Node mount = lidar && lidar.IsMap() ? lidar["mounting"] : YAML::Node();
+    if (mount && mount.IsMap() && mount["z_m"]) {
+      if (cfg.lidar.mounting.z_m > 0.0) {
+        cfg.perception.ground.zones.sensor_height_m = cfg.lidar.mounting.z_m;
+      } else if (cfg.perception.ground.method == perception::GroundMethod::Zones) {
+        r.issue(mount["z_m"], "lidar.mounting.z_m",
+                "perception.ground.method zones needs the LiDAR's height above the ground; give a positive z_m");
+      }
+    }
   }
   result.issues = std::move(r.issues());
   return result;

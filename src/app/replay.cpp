@@ -9,10 +9,18 @@
 #include <optional>
 #include <string>
 
+#include <fstream>
+
 #include "app/args.hpp"
+#include "app/bev.hpp"
 #include "app/commands.hpp"
 #include "app/logging.hpp"
+#include "app/obstacles_jsonl.hpp"
 #include "app/pcd_writer.hpp"
+#include "app/png_writer.hpp"
+#include "app/samples.hpp"
+#include "fieldguard/io/byte_log.hpp"
+#include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/drivers/velodyne_position.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
@@ -24,13 +32,26 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kHelp =
-    "usage: fieldguard replay --config FILE --pcap FILE [--pcd-dir DIR] [--quiet]\n"
+    "usage: fieldguard replay --config FILE (--pcap FILE | --session DIR) [--obstacles-out FILE] [--bev-dir DIR]\n"
+    "                         [--pcd-dir DIR] [--samples-out FILE] [--quiet]\n"
     "\n"
     "Runs a capture of Velodyne packets (classic pcap or pcapng; Ethernet, VLAN, Linux cooked SLL/SLL2 or raw\n"
     "IPv4) through the decoder and cuts it into rotations.\n"
     "\n"
     "  --config FILE   configuration (see config/fieldguard.yaml)\n"
     "  --pcap FILE     the capture\n"
+    "  --session DIR   a directory written by `fieldguard record`: DIR/lidar.pcap and the byte logs of the 2D\n"
+    "                  LiDAR (scan2d.log), GNSS (gnss.log) and AHRS (ahrs.log), each decoded by the same decoders\n"
+    "                  as live\n"
+    "  --scan2d-log FILE, --gnss-log FILE, --ahrs-log FILE\n"
+    "                  byte logs of a recording given one by one (with --pcap), instead of a --session\n"
+    "  --samples-out FILE  write every decoded sample of every sensor as a JSON line (as `record --samples-out`)\n"
+    "  --obstacles-out FILE  run the detection pipeline and write one JSON line per rotation, in order:\n"
+    "                  {\"frame\", \"stamp\" (s, capture time of the rotation's first packet), \"partial\",\n"
+    "                  \"points_in\", \"obstacles\": [{\"min\", \"max\" (m, sensor frame), \"points\", \"obb\",\n"
+    "                  \"distance\" (m), \"bearing\" (deg, + left), \"height\" (m above local ground), \"class\"}]}\n"
+    "  --bev-dir DIR   write a bird's-eye PNG per rotation (points by height, ground dimmed, obstacle boxes\n"
+    "                  with their distance, ROI and body box, 1 m grid)\n"
     "  --pcd-dir DIR   write one binary PCD per rotation: frame_NNNNNN.pcd, and frame_NNNNNN_partial.pcd for\n"
     "                  the first and last rotations when they are not a full turn (fields x y z intensity ring\n"
     "                  time; sensor frame x forward, y left, z up, metres; time in s after the rotation start)\n"
@@ -110,19 +131,57 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
   std::printf("  wall time         %.3f s\n", wall_s);
 }
 
+// The byte logs to replay: a session's, unless given one by one. Each entry: (path, sensor).
+enum class LogKind { Scan2d, Gnss, Ahrs };
+struct LogFile {
+  std::string path;
+  LogKind kind;
+};
+
+// Feeds the byte logs to the sample decoder and prints what each held. False when one cannot be read.
+bool replay_logs(const std::vector<LogFile>& logs, SampleDecoder& samples) {
+  for (const LogFile& l : logs) {
+    auto reader = io::ByteLogReader::open(l.path);
+    if (!reader) {
+      std::fprintf(stderr, "fieldguard replay: %s\n", reader.error().c_str());
+      return false;
+    }
+    std::uint64_t records = 0;
+    while (auto r = reader->next()) {
+      ++records;
+      switch (l.kind) {
+        case LogKind::Scan2d: samples.scan2d(r->bytes, r->direction == io::Direction::ToSensor); break;
+        case LogKind::Gnss: samples.gnss(r->bytes); break;
+        case LogKind::Ahrs: samples.ahrs(r->bytes); break;
+      }
+    }
+    std::printf("  %-17s %llu records (%s)%s%s\n", fs::path(l.path).filename().c_str(),
+                static_cast<unsigned long long>(records), reader->source().c_str(),
+                reader->truncated() ? ", cut short at the end" : "",
+                reader->error().empty() ? "" : (", " + reader->error()).c_str());
+  }
+  const auto& c = samples.counts();
+  std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages\n",
+              static_cast<unsigned long long>(c.scans), static_cast<unsigned long long>(c.gnss),
+              static_cast<unsigned long long>(c.ahrs));
+  return true;
+}
+
 }  // namespace
 
 int cmd_replay(const std::vector<std::string>& argv) {
-  const Args args(argv, {"config", "pcap", "pcd-dir"}, {"help", "quiet"});
+  const Args args(argv, {"config", "pcap", "session", "scan2d-log", "gnss-log", "ahrs-log", "pcd-dir", "bev-dir",
+                         "obstacles-out", "samples-out"},
+                  {"help", "quiet"});
   if (args.has("help")) {
     std::fputs(kHelp, stdout);
     return kExitOk;
   }
-  if (!args.ok() || !args.positional().empty() || !args.has("config") || !args.has("pcap")) {
+  if (!args.ok() || !args.positional().empty() || !args.has("config") || (args.has("pcap") == args.has("session"))) {
     std::fprintf(stderr, "fieldguard replay: %s\n%s",
                  !args.ok() ? args.error().c_str()
                  : !args.positional().empty() ? ("unexpected argument '" + args.positional().front() + "'").c_str()
-                                               : "--config and --pcap are required",
+                                               : "--config and one of --pcap or --session are required",
                  kHelp);
     return kExitBadInput;
   }
@@ -137,24 +196,64 @@ int cmd_replay(const std::vector<std::string>& argv) {
   }
   const Config& cfg = loaded.config;
 
-  const std::string pcap_path = *args.get("pcap");
+  const std::string session_dir = args.get("session").value_or("");
+  if (!session_dir.empty() && !fs::is_directory(session_dir)) {
+    std::fprintf(stderr, "fieldguard replay: %s is not a directory written by `fieldguard record`\n", session_dir.c_str());
+    return kExitBadInput;
+  }
+  const std::string pcap_path = session_dir.empty() ? *args.get("pcap") : (fs::path(session_dir) / "lidar.pcap").string();
+  std::ofstream samples_file;
+  if (auto s = args.get("samples-out")) {
+    samples_file.open(*s, std::ios::trunc);
+    if (!samples_file) {
+      std::fprintf(stderr, "fieldguard replay: cannot write %s\n", s->c_str());
+      return kExitBadInput;
+    }
+  }
+  std::vector<LogFile> logs;
+  const std::pair<const char*, LogKind> kLogNames[] = {
+      {"scan2d", LogKind::Scan2d}, {"gnss", LogKind::Gnss}, {"ahrs", LogKind::Ahrs}};
+  for (const auto& [name, kind] : kLogNames) {
+    if (auto given = args.get(std::string(name) + "-log")) {
+      logs.push_back({*given, kind});
+    } else if (!session_dir.empty() && fs::exists(fs::path(session_dir) / (std::string(name) + ".log"))) {
+      logs.push_back({(fs::path(session_dir) / (std::string(name) + ".log")).string(), kind});
+    }
+  }
+  std::optional<SampleDecoder> samples;
+  if (samples_file.is_open() || !logs.empty()) samples.emplace(cfg, samples_file.is_open() ? &samples_file : nullptr);
   auto reader = io::PcapReader::open(pcap_path);
   if (!reader) {
     std::fprintf(stderr, "fieldguard replay: %s\n", reader.error().c_str());
     return kExitBadInput;
   }
 
-  std::string pcd_dir;
-  if (auto d = args.get("pcd-dir")) {
-    pcd_dir = *d;
+  auto make_dir = [](const std::string& option, const std::string& dir) {
     std::error_code ec;
-    fs::create_directories(pcd_dir, ec);
-    if (ec || !fs::is_directory(pcd_dir)) {
-      std::fprintf(stderr, "fieldguard replay: cannot create the PCD directory %s: %s\n", pcd_dir.c_str(),
+    fs::create_directories(dir, ec);
+    if (ec || !fs::is_directory(dir)) {
+      std::fprintf(stderr, "fieldguard replay: cannot create the %s directory %s: %s\n", option.c_str(), dir.c_str(),
                    ec ? ec.message().c_str() : "a file of that name exists");
+      return false;
+    }
+    return true;
+  };
+  const std::string pcd_dir = args.get("pcd-dir").value_or("");
+  const std::string bev_dir = args.get("bev-dir").value_or("");
+  if (!pcd_dir.empty() && !make_dir("PCD", pcd_dir)) return kExitBadInput;
+  if (!bev_dir.empty() && !make_dir("bird's-eye", bev_dir)) return kExitBadInput;
+  std::ofstream obstacles_out;
+  if (auto o = args.get("obstacles-out")) {
+    obstacles_out.open(*o, std::ios::binary | std::ios::trunc);
+    if (!obstacles_out) {
+      std::fprintf(stderr, "fieldguard replay: cannot write %s\n", o->c_str());
       return kExitBadInput;
     }
   }
+  const bool detect = obstacles_out.is_open() || !bev_dir.empty();
+  std::optional<perception::Pipeline> pipeline;
+  if (detect) pipeline.emplace(cfg.perception);
+  std::uint64_t obstacles_total = 0;
 
   velodyne::StreamOptions so;
   so.model = cfg.lidar.model;
@@ -177,17 +276,31 @@ int cmd_replay(const std::vector<std::string>& argv) {
 
   auto handle_frames = [&]() {
     for (const auto& f : frames) {
-      if (pcd_dir.empty() || !write_error.empty()) continue;
-      char name[64];
-      std::snprintf(name, sizeof name, "frame_%06llu%s.pcd", static_cast<unsigned long long>(f.index),
+      if (!write_error.empty()) break;
+      char stem[64];
+      std::snprintf(stem, sizeof stem, "frame_%06llu%s", static_cast<unsigned long long>(f.index),
                     f.partial ? "_partial" : "");
-      write_error = write_pcd((fs::path(pcd_dir) / name).string(), f);
-      if (write_error.empty()) ++written;
+      if (!pcd_dir.empty()) {
+        write_error = write_pcd((fs::path(pcd_dir) / (std::string(stem) + ".pcd")).string(), f);
+        if (write_error.empty()) ++written;
+      }
+      if (!pipeline) continue;
+      const perception::FrameResult result = pipeline->process(f.points);
+      obstacles_total += result.obstacles.size();
+      if (obstacles_out.is_open()) {
+        obstacles_out << obstacles_json_line(f, result) << '\n';
+        if (!obstacles_out) write_error = "cannot write " + *args.get("obstacles-out");
+      }
+      if (!bev_dir.empty() && write_error.empty()) {
+        write_error = write_png((fs::path(bev_dir) / (std::string(stem) + ".png")).string(),
+                                render_bev(pipeline->last_points(), result, cfg.perception, std::nullopt));
+      }
     }
     frames.clear();
   };
 
   while (auto dg = reader->next()) {
+    if (samples) samples->lidar(*dg);
     if (first_time.ns == 0) first_time = dg->host_time;
     last_time = dg->host_time;
     if (dg->dst_port == cfg.lidar.data_port) {
@@ -227,6 +340,9 @@ int cmd_replay(const std::vector<std::string>& argv) {
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   print_summary(pcap_path, reader->stats(), stream, pos, ports, written, wall_s,
                 static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
+  if (pipeline) std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+  if (!logs.empty() && !replay_logs(logs, *samples)) return kExitBadInput;
+  if (samples) samples->finish();
 
   if (reader->stats().truncated) log->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path);
   if (!reader->stats().read_error.empty()) log->warn("{}: reading stopped early: {}", pcap_path, reader->stats().read_error);
@@ -240,6 +356,7 @@ int cmd_replay(const std::vector<std::string>& argv) {
     std::fprintf(stderr, "fieldguard replay: %s\n", write_error.c_str());
     return kExitFailure;
   }
+  if (!logs.empty() && stream.counters().packets == 0) return kExitOk;  // a recording without 3D LiDAR data
   if (stream.counters().packets == 0) {
     std::fprintf(stderr, "fieldguard replay: %s holds no UDP datagram to the data port %u: not a Velodyne capture, or "
                  "lidar.data_port is wrong\n", pcap_path.c_str(), cfg.lidar.data_port);

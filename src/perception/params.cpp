@@ -1,2 +1,26 @@
-// perception arrives with the obstacle-detection issue; its parameter structs live in the header.
 #include "fieldguard/perception/params.hpp"
+
+namespace fieldguard::perception {
+
+PipelineParams published_params() {
+  PipelineParams p;
+  p.voxel = VoxelParams{};
+  p.voxel.leaf_m = 0.15;
+  p.voxel.coarse_from_m = 0.0;
+  p.roi = Box3{{-10.0, -10.0, -1.5}, {50.0, 10.0, 6.0}};
+  p.body = Box3{{-5.0, -1.5, -1.5}, {0.4, 1.5, 1.5}};
+  p.ground.method = GroundMethod::Ransac;
+  p.ground.ransac = RansacParams{60, 0.3, 42};
+  p.cluster.method = ClusterMethod::Fixed;
+  p.cluster.structure = ClusterStructure::KdTree;
+  p.cluster.tolerance_m = 0.6;
+  p.filters.min_points = 10;
+  p.filters.max_points = 240;
+  p.filters.min_volume_m3 = 0.06;
+  p.filters.max_volume_m3 = 1.2;
+  p.filters.min_height_m = 0.0;
+  p.filters.min_points_full_range_m = 0.0;
+  return p;
+}
+
+}  // namespace fieldguard::perception

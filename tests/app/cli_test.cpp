@@ -40,7 +40,10 @@ TEST(Cli, UsageErrorsExitTwo) {
   EXPECT_NE(o.output.find("unknown option --colour"), std::string::npos) << o.output;
   auto m = run_fieldguard("replay --pcap y");
   EXPECT_EQ(m.exit_code, 2);
-  EXPECT_NE(m.output.find("--config and --pcap are required"), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find("--config and one of --pcap or --session are required"), std::string::npos) << m.output;
+  auto both = run_fieldguard("replay --config x --pcap y --session z");
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.output.find("one of --pcap or --session"), std::string::npos) << both.output;
 }
 
 TEST(CheckConfig, ShippedFilesAreValid) {

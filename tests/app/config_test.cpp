@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace fieldguard::app {
 namespace {
@@ -53,6 +54,142 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, 0.06);
   EXPECT_DOUBLE_EQ(p.filters.max_volume_m3, 1.2);
   EXPECT_EQ(r.config.lidar.model, velodyne::Model::HDL32E);
+  // Nothing of ours is switched on.
+  EXPECT_DOUBLE_EQ(p.voxel.coarse_from_m, 0.0);
+  EXPECT_EQ(p.cluster.method, perception::ClusterMethod::Fixed);
+  EXPECT_EQ(p.cluster.structure, perception::ClusterStructure::KdTree);
+  EXPECT_DOUBLE_EQ(p.filters.min_height_m, 0.0);
+  EXPECT_DOUBLE_EQ(p.filters.min_points_full_range_m, 0.0);
+  // And it is what the perception module calls the published method.
+  const auto pub = perception::published_params();
+  EXPECT_EQ(p.ground.method, pub.ground.method);
+  EXPECT_EQ(p.ground.ransac.iterations, pub.ground.ransac.iterations);
+  EXPECT_EQ(p.cluster.method, pub.cluster.method);
+  EXPECT_EQ(p.filters.max_points, pub.filters.max_points);
+  EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, pub.filters.min_volume_m3);
+}
+
+TEST(ConfigFiles, FieldguardUsesTheFieldMethods) {
+  const auto r = load_config_file(std::string(FIELDGUARD_SOURCE_DIR) + "/config/fieldguard.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& p = r.config.perception;
+  EXPECT_EQ(p.ground.method, perception::GroundMethod::Zones);
+  EXPECT_EQ(p.cluster.method, perception::ClusterMethod::Adaptive);
+  EXPECT_EQ(p.cluster.structure, perception::ClusterStructure::Grid);
+  EXPECT_GT(p.filters.min_height_m, 0.0);
+  EXPECT_DOUBLE_EQ(p.ground.zones.sensor_height_m, r.config.lidar.mounting.z_m);
+  EXPECT_EQ(p.ground.zones.rings.size() + 1, p.ground.zones.edges_m.size());
+}
+
+TEST(ConfigLoad, ReadsEveryPerceptionKey) {
+  const auto r = load_config_text(R"(
+lidar:
+  mounting: {z_m: 1.8}
+perception:
+  voxel: {leaf_m: 0.1, coarse_from_m: 20, max_leaf_m: 0.3}
+  ground:
+    method: zones
+    ransac: {iterations: 100, distance_m: 0.2, seed: 7}
+    zones:
+      edges_m: [1, 5, 40]
+      rings: [3, 6]
+      sectors: [8, 24]
+      min_bin_points: 5
+      seed_lowest: 12
+      seed_margin_m: 0.1
+      fit_distance_m: 0.12
+      fit_iterations: 2
+      ground_threshold_m: 0.25
+      max_slope_deg: 20
+      max_tilt_deg: 8
+      max_step_m: 0.3
+      max_slope_change_deg: 4
+      min_spread_m: 0.7
+      max_extrapolation_m: 20
+  cluster: {method: adaptive, structure: kdtree, tolerance_m: 0.5, beam_spacing_deg: 2.0, beam_factor: 1.5, max_tolerance_m: 1.0}
+  filters: {min_points: 8, max_points: 0, min_volume_m3: 0.01, max_volume_m3: 0, min_height_m: 0.4,
+            min_points_full_range_m: 15, min_points_floor: 2}
+)",
+                                  "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& p = r.config.perception;
+  EXPECT_DOUBLE_EQ(p.voxel.leaf_m, 0.1);
+  EXPECT_DOUBLE_EQ(p.voxel.coarse_from_m, 20.0);
+  EXPECT_DOUBLE_EQ(p.voxel.max_leaf_m, 0.3);
+  EXPECT_EQ(p.ground.method, perception::GroundMethod::Zones);
+  EXPECT_EQ(p.ground.ransac.iterations, 100);
+  EXPECT_DOUBLE_EQ(p.ground.ransac.distance_m, 0.2);
+  EXPECT_EQ(p.ground.ransac.seed, 7U);
+  const auto& z = p.ground.zones;
+  EXPECT_EQ(z.edges_m, (std::vector<double>{1, 5, 40}));
+  EXPECT_EQ(z.rings, (std::vector<int>{3, 6}));
+  EXPECT_EQ(z.sectors, (std::vector<int>{8, 24}));
+  EXPECT_EQ(z.min_bin_points, 5);
+  EXPECT_EQ(z.seed_lowest, 12);
+  EXPECT_DOUBLE_EQ(z.seed_margin_m, 0.1);
+  EXPECT_DOUBLE_EQ(z.fit_distance_m, 0.12);
+  EXPECT_EQ(z.fit_iterations, 2);
+  EXPECT_DOUBLE_EQ(z.ground_threshold_m, 0.25);
+  EXPECT_DOUBLE_EQ(z.max_slope_deg, 20.0);
+  EXPECT_DOUBLE_EQ(z.max_tilt_deg, 8.0);
+  EXPECT_DOUBLE_EQ(z.max_step_m, 0.3);
+  EXPECT_DOUBLE_EQ(z.max_slope_change_deg, 4.0);
+  EXPECT_DOUBLE_EQ(z.min_spread_m, 0.7);
+  EXPECT_DOUBLE_EQ(z.max_extrapolation_m, 20.0);
+  EXPECT_DOUBLE_EQ(z.sensor_height_m, 1.8);  // from lidar.mounting.z_m
+  const auto& c = p.cluster;
+  EXPECT_EQ(c.method, perception::ClusterMethod::Adaptive);
+  EXPECT_EQ(c.structure, perception::ClusterStructure::KdTree);
+  EXPECT_DOUBLE_EQ(c.tolerance_m, 0.5);
+  EXPECT_DOUBLE_EQ(c.beam_spacing_deg, 2.0);
+  EXPECT_DOUBLE_EQ(c.beam_factor, 1.5);
+  EXPECT_DOUBLE_EQ(c.max_tolerance_m, 1.0);
+  const auto& f = p.filters;
+  EXPECT_EQ(f.min_points, 8);
+  EXPECT_EQ(f.max_points, 0);
+  EXPECT_DOUBLE_EQ(f.min_volume_m3, 0.01);
+  EXPECT_DOUBLE_EQ(f.max_volume_m3, 0.0);
+  EXPECT_DOUBLE_EQ(f.min_height_m, 0.4);
+  EXPECT_DOUBLE_EQ(f.min_points_full_range_m, 15.0);
+  EXPECT_EQ(f.min_points_floor, 2);
+}
+
+// 0 switches the upper limits off, so a large minimum with a zero maximum is no contradiction.
+TEST(ConfigLoad, ZeroMaximumIsNoLimit) {
+  const auto r = load_config_text(
+      "perception: {filters: {min_points: 300, max_points: 0, min_volume_m3: 5, max_volume_m3: 0}}\n", "t.yaml");
+  EXPECT_TRUE(r.ok()) << dump(r);
+}
+
+// Every perception problem at once, each with its line.
+TEST(ConfigLoad, ReportsEveryPerceptionProblemWithLine) {
+  const std::string text =
+      "perception:\n"                                                 // 1
+      "  ground:\n"                                                   // 2
+      "    method: zones\n"                                           // 3
+      "    zones:\n"                                                  // 4
+      "      edges_m: [2, 10, 6]\n"                                   // 5  not increasing
+      "      rings: [2, 4, 4]\n"                                      // 6  three counts for two zones
+      "      sectors: [16, x]\n"                                      // 7  not a number
+      "      max_slope_deg: 95\n"                                     // 8  out of range
+      "  cluster:\n"                                                  // 9
+      "    method: adaptive\n"                                        // 10
+      "    tolerance_m: 0.8\n"                                        // 11
+      "    max_tolerance_m: 0.5\n"                                    // 12 below tolerance_m
+      "    beam_spacing_deg: 5\n"                                     // 13
+      "    beam_factor: 9\n"                                          // 14 9 * tan(5 deg): grows too fast
+      "  voxel: {leaf_m: 0.2, coarse_from_m: 10, max_leaf_m: 0.1}\n"  // 15 max_leaf < leaf
+      "  filters: {min_height_m: -1}\n";                              // 16 out of range
+  const auto r = load_config_text(text, "bad.yaml");
+  EXPECT_TRUE(has_issue(r, "perception.ground.zones.edges_m", "must increase", 5)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.ground.zones.rings", "one ring count per zone", 6)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.ground.zones.sectors[1]", "expected a whole number", 7)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.ground.zones.max_slope_deg", "out of range", 8)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.max_tolerance_m", "must not be less than tolerance_m", 12)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.beam_factor", "below 0.5", 14)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.voxel.max_leaf_m", "must not be less than leaf_m", 15)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.filters.min_height_m", "out of range", 16)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 8U) << dump(r);
 }
 
 TEST(ConfigLoad, ReadsEveryLidarKey) {
@@ -84,22 +221,22 @@ lidar:
 // Every kind of problem in one file: all are reported at once, each with its line and key path.
 TEST(ConfigLoad, ReportsEveryProblemAtOnceWithLineAndKey) {
   const std::string text =
-      "lidar:\n"                                   // 1
-      "  model: HDL-64\n"                          // 2  not one of the choices
-      "  data_port: 70000\n"                       // 3  out of range
-      "  min_range_m: fast\n"                      // 4  wrong type
-      "  colour: red\n"                            // 5  unknown key
-      "perception:\n"                              // 6
-      "  roi:\n"                                   // 7
-      "    min: [10, -10, -1.5]\n"                 // 8
-      "    max: [5, 10, 6]\n"                      // 9  min x > max x
-      "  body:\n"                                  // 10
-      "    min: [-5, -1.5, -1.5]\n"                // 11
-      "    max: [0.4, 1.5, 9]\n"                   // 12 body outside the ROI
-      "  filters:\n"                               // 13
-      "    min_points: 300\n"                      // 14
-      "    max_points: 240\n"                      // 15 min > max
-      "  cluster: {tolerance_m: [1, 2]}\n";        // 16 a list where a number belongs
+      "lidar:\n"                             // 1
+      "  model: HDL-64\n"                    // 2  not one of the choices
+      "  data_port: 70000\n"                 // 3  out of range
+      "  min_range_m: fast\n"                // 4  wrong type
+      "  colour: red\n"                      // 5  unknown key
+      "perception:\n"                        // 6
+      "  roi:\n"                             // 7
+      "    min: [10, -10, -1.5]\n"           // 8
+      "    max: [5, 10, 6]\n"                // 9  min x > max x
+      "  body:\n"                            // 10
+      "    min: [-5, -1.5, -1.5]\n"          // 11
+      "    max: [0.4, 1.5, 9]\n"             // 12 body outside the ROI
+      "  filters:\n"                         // 13
+      "    min_points: 300\n"                // 14
+      "    max_points: 240\n"                // 15 min > max
+      "  cluster: {tolerance_m: [1, 2]}\n";  // 16 a list where a number belongs
   const auto r = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(r, "lidar.model", "not one of auto, HDL-32E, VLP-16", 2)) << dump(r);
   EXPECT_TRUE(has_issue(r, "lidar.data_port", "out of range", 3)) << dump(r);
@@ -135,7 +272,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"not_yaml", "lidar: [1, 2\n", "", "not valid YAML"},
         BadCase{"empty", "", "", "empty"},
         BadCase{"top_level_list", "- 1\n- 2\n", "", "expected a mapping"},
-        BadCase{"unknown_top", "lidr: {}\n", "lidr", "unknown key; known keys here: lidar, perception"},
+        BadCase{"unknown_top", "lidr: {}\n", "lidr", "unknown key; known keys here: lidar, scan2d, gnss, ahrs, perception"},
         BadCase{"duplicate", "lidar:\n  data_port: 1\n  data_port: 2\n", "lidar.data_port", "given twice"},
         BadCase{"section_scalar", "perception: 3\n", "perception", "expected a mapping"},
         BadCase{"vec_short", "perception: {roi: {min: [1, 2]}}\n", "perception.roi.min", "list of 3 numbers"},
@@ -148,7 +285,29 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"ranges", "lidar: {min_range_m: 50, max_range_m: 10}\n", "lidar.max_range_m", "greater than"},
         BadCase{"same_ports", "lidar: {data_port: 2368, position_port: 2368}\n", "lidar.position_port", "same"},
         BadCase{"ground_method", "perception: {ground: {method: magic}}\n", "perception.ground.method",
-                "not one of ransac"},
+                "not one of ransac, zones"},
+        BadCase{"cluster_method", "perception: {cluster: {method: dbscan}}\n", "perception.cluster.method",
+                "not one of fixed, adaptive"},
+        BadCase{"cluster_structure", "perception: {cluster: {structure: octree}}\n", "perception.cluster.structure",
+                "not one of kdtree, grid"},
+        BadCase{"zone_key", "perception: {ground: {zones: {bins: 3}}}\n", "perception.ground.zones.bins",
+                "unknown key"},
+        BadCase{"zone_edges_short", "perception: {ground: {zones: {edges_m: [2]}}}\n",
+                "perception.ground.zones.edges_m", "list of 2 to 17"},
+        BadCase{"zone_edges_scalar", "perception: {ground: {zones: {edges_m: 5}}}\n",
+                "perception.ground.zones.edges_m", "list of 2 to 17"},
+        BadCase{"zone_sectors_zero", "perception: {ground: {zones: {sectors: [16, 0, 48, 64]}}}\n",
+                "perception.ground.zones.sectors[1]", "out of range"},
+        BadCase{"zone_rings_float", "perception: {ground: {zones: {rings: [2, 4.5, 4, 4]}}}\n",
+                "perception.ground.zones.rings[1]", "whole number"},
+        BadCase{"zone_sensor_height", "lidar: {mounting: {z_m: 0}}\nperception: {ground: {method: zones}}\n",
+                "lidar.mounting.z_m", "height above the ground"},
+        BadCase{"max_leaf_bands", "perception: {voxel: {leaf_m: 0.1, coarse_from_m: 10, max_leaf_m: 2}}\n",
+                "perception.voxel.max_leaf_m", "15 times"},
+        BadCase{"floor_zero", "perception: {filters: {min_points_floor: 0}}\n", "perception.filters.min_points_floor",
+                "out of range"},
+        BadCase{"full_range_negative", "perception: {filters: {min_points_full_range_m: -3}}\n",
+                "perception.filters.min_points_full_range_m", "out of range"},
         BadCase{"ransac_iter", "perception: {ground: {ransac: {iterations: 0}}}\n",
                 "perception.ground.ransac.iterations", "out of range"},
         BadCase{"missing_calibration", "lidar: {calibration_file: /nonexistent/cal.xml}\n", "lidar.calibration_file",

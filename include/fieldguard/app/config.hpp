@@ -29,9 +29,47 @@ struct LidarConfig {
   bool has_calibration = false;
 };
 
+// Hokuyo UTM-30LX-EW over SCIP 2.0 (TCP): covers the near blind zone in front of the 3D LiDAR.
+struct Scan2dConfig {
+  bool enabled = false;
+  std::string host = "192.168.0.10";
+  std::uint16_t port = 10940;
+  int start_step = 0;               // 0..1080, front at 540
+  int end_step = 1080;
+  bool intensity = false;           // ME (range + intensity) instead of MD
+  double connect_timeout_s = 2.0;
+  double silence_timeout_s = 0.5;   // a UTM-30LX-EW streams 40 scans a second
+  double backoff_max_s = 5.0;
+  Mounting mounting;
+};
+
+// A serial sensor link (GNSS NMEA, Xsens MTi).
+struct SerialConfig {
+  bool enabled = false;
+  std::string device;
+  unsigned baud = 115200;
+  unsigned data_bits = 8;
+  char parity = 'N';
+  unsigned stop_bits = 1;
+  double silence_timeout_s = 1.0;
+  double reopen_interval_s = 1.0;
+};
+
+struct GnssConfig {
+  SerialConfig serial;
+};
+
+struct AhrsConfig {
+  SerialConfig serial;
+  Mounting mounting;  // the AHRS's axes in the vehicle frame
+};
+
 struct Config {
   std::string source_file;  // the file it was loaded from
   LidarConfig lidar;
+  Scan2dConfig scan2d;
+  GnssConfig gnss;
+  AhrsConfig ahrs;
   perception::PipelineParams perception;
 };
 

@@ -1,10 +1,12 @@
 #pragma once
 // Parameters of the obstacle-detection pipeline: plain values, filled by the app's config loader.
 // Units are in the names. Defaults are config/fieldguard.yaml's; config/published.yaml holds the
-// published method's values.
+// published method's values (and switches every addition of ours off).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace fieldguard::perception {
 
@@ -21,32 +23,81 @@ struct Box3 {
 
 struct VoxelParams {
   double leaf_m = 0.15;  // edge of a voxel; each occupied voxel becomes the centroid of its points
+  // Coarser leaf with range: 0 = off (one leaf everywhere). Otherwise a point at horizontal range r uses the
+  // leaf leaf_m * max(1, floor(r / coarse_from_m)), capped at max_leaf_m (bands of whole multiples, so every
+  // band is one regular grid).
+  double coarse_from_m = 0.0;
+  double max_leaf_m = 0.45;
 };
 
-// Ground segmentation. The published method is one RANSAC plane; the issue that builds the detection
-// pipeline adds a method for fields that are not one plane.
-enum class GroundMethod : std::uint8_t { Ransac };
+// Ground segmentation. Ransac: the published method, one plane for the whole frame. Zones: local planes on
+// a polar grid of concentric zones (after Patchwork++'s concentric zone model), for fields that are not one
+// plane: slopes, furrows, ridges, the tractor's roll and pitch.
+enum class GroundMethod : std::uint8_t { Ransac = 0, Zones = 1 };
 
 struct RansacParams {
-  int iterations = 60;
+  int iterations = 60;      // maximum plane hypotheses; stops earlier at 99 % confidence, as PCL's RANSAC does
   double distance_m = 0.3;  // inlier distance from the plane
   std::uint32_t seed = 42;  // fixed, so replay output is reproducible
 };
 
-struct GroundParams {
-  GroundMethod method = GroundMethod::Ransac;
-  RansacParams ransac;
+struct ZoneParams {
+  // Concentric zones by horizontal range from the sensor: zone i spans [edges_m[i], edges_m[i+1]) and is cut
+  // into rings[i] rings of equal width and sectors[i] sectors of equal angle. Points nearer than the first
+  // edge belong to the first ring, points beyond the last edge to the last ring.
+  std::vector<double> edges_m{2.0, 6.0, 14.0, 26.0, 50.0};
+  std::vector<int> rings{2, 4, 4, 4};
+  std::vector<int> sectors{16, 32, 48, 64};
+  int min_bin_points = 4;             // a bin with fewer points takes the ground of the bin inside it
+  int seed_lowest = 10;               // seeds: the mean of this many lowest points ...
+  double seed_margin_m = 0.15;        // ... plus this margin; heights measured along the inner bin's slope
+  double fit_distance_m = 0.15;       // refit: points nearer than this to the plane
+  int fit_iterations = 3;             // plane refits
+  double ground_threshold_m = 0.2;    // a point less than this above its local ground plane is ground
+  double max_slope_deg = 25.0;        // a bin plane steeper than this is not ground
+  double max_tilt_deg = 10.0;         // innermost ring: allowed tilt of the ground (vehicle roll and pitch)
+  double max_step_m = 0.25;           // a bin's ground may differ this much from the inner bin's plane continued ...
+  double max_slope_change_deg = 5.0;  // ... plus the rise of this slope change over the distance between them
+  double min_spread_m = 0.8;          // a bin's ground points must spread at least this far (m, bbox diagonal)
+  // Ground farther than this from any bin fitted to its own points is a guess (no ring reached it): a cluster
+  // standing only on such ground counts its own vertical extent as its height above ground.
+  double max_extrapolation_m = 20.0;
+  double sensor_height_m = 0.95;      // the LiDAR above flat ground; the loader copies lidar.mounting.z_m
 };
 
+struct GroundParams {
+  GroundMethod method = GroundMethod::Zones;
+  RansacParams ransac;
+  ZoneParams zones;
+};
+
+// Euclidean clustering. Fixed: one radius. Adaptive: the radius grows with range so that a sensor's rings,
+// which drift apart with distance, still join: radius(r) = min(max_tolerance_m, max(tolerance_m,
+// beam_factor * r * tan(beam_spacing_deg))) at 3D range r; two points join when nearer than the larger of
+// their radii. Structure: KdTree (as PCL's EuclideanClusterExtraction) or Grid (cells of the radius); both
+// give the same clusters.
+enum class ClusterMethod : std::uint8_t { Fixed = 0, Adaptive = 1 };
+enum class ClusterStructure : std::uint8_t { KdTree = 0, Grid = 1 };
+
 struct ClusterParams {
-  double tolerance_m = 0.6;  // Euclidean clustering radius
+  ClusterMethod method = ClusterMethod::Adaptive;
+  ClusterStructure structure = ClusterStructure::Grid;
+  double tolerance_m = 0.6;        // Euclidean clustering radius (fixed), smallest radius (adaptive)
+  double beam_spacing_deg = 1.33;  // vertical angle between adjacent rings (HDL-32E: 1.33)
+  double beam_factor = 1.3;        // adaptive radius as a multiple of the gap between adjacent rings
+  double max_tolerance_m = 1.2;    // adaptive radius cap
 };
 
 struct FilterParams {
-  int min_points = 10;
-  int max_points = 240;
-  double min_volume_m3 = 0.06;
-  double max_volume_m3 = 1.2;
+  int min_points = 6;
+  int max_points = 0;  // 0 = no upper limit
+  double min_volume_m3 = 0.0;
+  double max_volume_m3 = 0.0;  // 0 = no upper limit
+  double min_height_m = 0.5;   // highest point above the local ground; 0 = off
+  // Far objects get few returns: beyond this distance the minimum point count falls as
+  // min_points * (min_points_full_range_m / d)^2, never below min_points_floor. 0 = off.
+  double min_points_full_range_m = 12.0;
+  int min_points_floor = 2;
 };
 
 struct PipelineParams {
@@ -57,5 +108,8 @@ struct PipelineParams {
   ClusterParams cluster;
   FilterParams filters;
 };
+
+// The published pipeline's parameters (config/published.yaml): for tests and benchmarks.
+[[nodiscard]] PipelineParams published_params();
 
 }  // namespace fieldguard::perception

@@ -28,6 +28,10 @@ class Pipeline {
   // The points of the last processed frame after ROI and voxel grid, labelled; valid until the next process().
   [[nodiscard]] std::span<const LabeledPoint> last_points() const;
 
+  // The local ground height (m, sensor frame) under (x, y) as the last processed frame found it: the RANSAC
+  // plane, or the plane of the zone bin (x, y) falls in. The level plane at -sensor_height before any frame.
+  [[nodiscard]] float ground_z(float x, float y) const;
+
   [[nodiscard]] const PipelineParams& params() const;
 
  private:

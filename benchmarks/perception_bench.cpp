@@ -1,0 +1,488 @@
+// Obstacle detection, each stage and the whole pipeline, side by side with the stock-PCL way of doing the
+// same step, in the same run on the same frames:
+//   bench_perception [--benchmark_filter=...] [--benchmark_min_time=...]
+// Frames: a synthetic HDL-32E rotation over a bordered field (benchmarks/synthetic_scene.hpp) at 10 Hz
+// (~69,000 points) and 5 Hz (~137,000 points); or rotations of the scene simulator given as PCD files:
+//   fieldguard-sim --scene shed --rate 10 --pcap s10.pcap;  fieldguard replay --config ... --pcap s10.pcap
+//   --pcd-dir d10;  bench_perception --frame10=d10/frame_000005.pcd --frame5=d5/frame_000005.pcd
+// Every iteration runs ours three times, then PCL's three times, on the same input, timing each with the
+// thread's CPU clock (and std::chrono for wall time). Counters: medians of the warm runs (after a run of the
+// same side) and of the cold ones (the first after the other side's), and their ratios (x_faster_than_pcl,
+// x_faster_cold). CPU time is the steady measure on a shared machine. A summary table follows the runs.
+// Settings: config/fieldguard.yaml and config/published.yaml through the app's loader; stock PCL with the
+// published values (CropBox ROI and negative body box, VoxelGrid 0.15 m, SACSegmentation plane RANSAC 60
+// iterations 0.3 m, EuclideanClusterExtraction 0.6 m over search::KdTree with 10..240 points).
+#include <benchmark/benchmark.h>
+#include <pcl/ModelCoefficients.h>
+#include <pcl/common/common.h>
+#include <pcl/filters/crop_box.h>
+#include <pcl/filters/extract_indices.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/sample_consensus/method_types.h>
+#include <pcl/sample_consensus/model_types.h>
+#include <pcl/search/kdtree.h>
+#include <pcl/segmentation/extract_clusters.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <stdexcept>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "fieldguard/app/config.hpp"
+#include "fieldguard/perception/crop.hpp"
+#include "fieldguard/perception/euclidean_cluster.hpp"
+#include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/perception/ransac_ground.hpp"
+#include "fieldguard/perception/voxel_grid.hpp"
+#include "fieldguard/perception/zone_ground.hpp"
+#include "synthetic_scene.hpp"
+
+namespace {
+
+using namespace fieldguard;
+using namespace fieldguard::perception;
+using PclCloud = pcl::PointCloud<pcl::PointXYZ>;
+
+// ---- settings ----
+
+PipelineParams load_params(const char* file) {
+  // FIELDGUARD_TEST_DATA is <source>/tests/data.
+  const auto r = app::load_config_file(std::string(FIELDGUARD_TEST_DATA) + "/../../config/" + file);
+  if (!r.ok()) {
+    std::fprintf(stderr, "%s: %s\n", file, r.issues.front().to_string().c_str());
+    std::exit(2);
+  }
+  return r.config.perception;
+}
+const PipelineParams& fieldguard_params() {
+  static const PipelineParams p = load_params("fieldguard.yaml");
+  return p;
+}
+const PipelineParams& published() {
+  static const PipelineParams p = load_params("published.yaml");
+  return p;
+}
+
+// ---- frames and the inputs of every stage, ours and PCL's, computed once ----
+
+struct Frame {
+  std::string name;
+  std::vector<LidarPoint> points;
+  PclCloud::Ptr pcl_points{new PclCloud};
+  // Our stage inputs (published settings, so both sides see the same data sizes).
+  Cloud cropped, voxels, above;
+  // PCL's.
+  PclCloud::Ptr pcl_cropped{new PclCloud}, pcl_voxels{new PclCloud}, pcl_above{new PclCloud};
+};
+
+void pcl_crop(const PclCloud::Ptr& in, PclCloud& out, const PipelineParams& p) {
+  const auto v4 = [](const std::array<double, 3>& a) {
+    return Eigen::Vector4f(static_cast<float>(a[0]), static_cast<float>(a[1]), static_cast<float>(a[2]), 1.F);
+  };
+  PclCloud::Ptr roi(new PclCloud);
+  pcl::CropBox<pcl::PointXYZ> crop;
+  crop.setInputCloud(in);
+  crop.setMin(v4(p.roi.min));
+  crop.setMax(v4(p.roi.max));
+  crop.filter(*roi);
+  pcl::CropBox<pcl::PointXYZ> body;
+  body.setInputCloud(roi);
+  body.setMin(v4(p.body.min));
+  body.setMax(v4(p.body.max));
+  body.setNegative(true);
+  body.filter(out);
+}
+
+void pcl_voxel(const PclCloud::Ptr& in, PclCloud& out, double leaf) {
+  pcl::VoxelGrid<pcl::PointXYZ> vg;
+  vg.setInputCloud(in);
+  const auto l = static_cast<float>(leaf);
+  vg.setLeafSize(l, l, l);
+  vg.filter(out);
+}
+
+std::size_t pcl_ground(const PclCloud::Ptr& in, pcl::PointIndices& inliers, int iterations, double distance) {
+  pcl::SACSegmentation<pcl::PointXYZ> seg;
+  seg.setOptimizeCoefficients(true);
+  seg.setModelType(pcl::SACMODEL_PLANE);
+  seg.setMethodType(pcl::SAC_RANSAC);
+  seg.setMaxIterations(iterations);
+  seg.setDistanceThreshold(distance);
+  seg.setInputCloud(in);
+  pcl::ModelCoefficients coeff;
+  seg.segment(inliers, coeff);
+  return inliers.indices.size();
+}
+
+std::size_t pcl_clusters(const PclCloud::Ptr& in, double tolerance, int min_pts, int max_pts) {
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  tree->setInputCloud(in);
+  pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
+  ec.setClusterTolerance(tolerance);
+  ec.setMinClusterSize(static_cast<pcl::uindex_t>(min_pts));
+  ec.setMaxClusterSize(static_cast<pcl::uindex_t>(max_pts));
+  ec.setSearchMethod(tree);
+  ec.setInputCloud(in);
+  std::vector<pcl::PointIndices> clusters;
+  ec.extract(clusters);
+  return clusters.size();
+}
+
+// The stock-PCL pipeline, published settings: crop, voxel grid, RANSAC plane, the rest clustered, boxes.
+std::size_t pcl_pipeline(const PclCloud::Ptr& in) {
+  const PipelineParams& p = published();
+  PclCloud::Ptr cropped(new PclCloud), voxels(new PclCloud), above(new PclCloud);
+  pcl_crop(in, *cropped, p);
+  pcl_voxel(cropped, *voxels, p.voxel.leaf_m);
+  pcl::PointIndices::Ptr ground(new pcl::PointIndices);
+  pcl_ground(voxels, *ground, p.ground.ransac.iterations, p.ground.ransac.distance_m);
+  pcl::ExtractIndices<pcl::PointXYZ> extract;
+  extract.setInputCloud(voxels);
+  extract.setIndices(ground);
+  extract.setNegative(true);
+  extract.filter(*above);
+  pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
+  tree->setInputCloud(above);
+  pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
+  ec.setClusterTolerance(p.cluster.tolerance_m);
+  ec.setMinClusterSize(static_cast<pcl::uindex_t>(p.filters.min_points));
+  ec.setMaxClusterSize(static_cast<pcl::uindex_t>(p.filters.max_points));
+  ec.setSearchMethod(tree);
+  ec.setInputCloud(above);
+  std::vector<pcl::PointIndices> clusters;
+  ec.extract(clusters);
+  std::size_t obstacles = 0;
+  for (const auto& c : clusters) {
+    Eigen::Vector4f lo, hi;
+    pcl::getMinMax3D(*above, c.indices, lo, hi);
+    const Eigen::Vector4f size = hi - lo;
+    const double v = static_cast<double>(size[0] * size[1] * size[2]);
+    if (v >= p.filters.min_volume_m3 && v <= p.filters.max_volume_m3) ++obstacles;
+  }
+  return obstacles;
+}
+
+// Frames from files, when given: --frame10=FILE --frame5=FILE, binary PCD as `fieldguard replay --pcd-dir`
+// writes them (fields x y z intensity ring time), e.g. of the simulator's `shed` scene.
+std::string& frame_file(int which) {
+  static std::string files[2];
+  return files[which];
+}
+
+std::vector<LidarPoint> load_pcd(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto data = s.find("DATA binary\n");
+  const auto count_at = s.find("\nPOINTS ");
+  if (!in.good() && s.empty()) throw std::runtime_error("cannot read " + path);
+  if (data == std::string::npos || count_at == std::string::npos || s.find("FIELDS x y z intensity ring time") == std::string::npos) {
+    throw std::runtime_error(path + ": not a fieldguard binary PCD (FIELDS x y z intensity ring time)");
+  }
+  const std::size_t count = std::stoul(s.substr(count_at + 8));
+  constexpr std::size_t kStride = 22;  // 4 + 4 + 4 + 4 + 2 + 4 bytes
+  const std::size_t begin = data + 12;
+  if (s.size() < begin + count * kStride) throw std::runtime_error(path + ": shorter than its POINTS");
+  std::vector<LidarPoint> out(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const char* d = s.data() + begin + i * kStride;
+    std::memcpy(&out[i].x, d, 4);
+    std::memcpy(&out[i].y, d + 4, 4);
+    std::memcpy(&out[i].z, d + 8, 4);
+    std::memcpy(&out[i].intensity, d + 12, 4);
+    std::memcpy(&out[i].ring, d + 16, 2);
+    std::memcpy(&out[i].time_s, d + 18, 4);
+  }
+  return out;
+}
+
+Frame make_frame(const char* name, double hz, const std::string& file) {
+  Frame f;
+  f.name = name;
+  if (!file.empty()) {
+    f.points = load_pcd(file);
+  } else {
+    sim::ScanSpec spec;
+    spec.rotation_hz = hz;
+    f.points = sim::scan(sim::benchmark_scene(), spec);
+  }
+  for (const auto& p : f.points) f.pcl_points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
+  const PipelineParams& p = published();
+  crop_box(f.points, p.roi, p.body, f.cropped);
+  VoxelGrid grid(p.voxel);
+  grid.filter(f.cropped, f.voxels);
+  RansacGround ransac(p.ground.ransac, p.ground.zones.sensor_height_m);
+  GroundLabels labels;
+  ransac.segment(f.voxels, labels);
+  for (std::size_t i = 0; i < f.voxels.size(); ++i) {
+    if (labels.ground[i] == 0U) f.above.push_back(f.voxels.x[i], f.voxels.y[i], f.voxels.z[i]);
+  }
+  pcl_crop(f.pcl_points, *f.pcl_cropped, p);
+  pcl_voxel(f.pcl_cropped, *f.pcl_voxels, p.voxel.leaf_m);
+  pcl::PointIndices ground;
+  pcl_ground(f.pcl_voxels, ground, p.ground.ransac.iterations, p.ground.ransac.distance_m);
+  std::vector<char> is_ground(f.pcl_voxels->size(), 0);
+  for (const int i : ground.indices) is_ground[static_cast<std::size_t>(i)] = 1;
+  for (std::size_t i = 0; i < f.pcl_voxels->size(); ++i) {
+    if (is_ground[i] == 0) f.pcl_above->push_back((*f.pcl_voxels)[i]);
+  }
+  return f;
+}
+
+Frame& frame(int which) {
+  static Frame f10 = make_frame("10Hz", 10.0, frame_file(0));
+  static Frame f5 = make_frame("5Hz", 5.0, frame_file(1));
+  return which == 0 ? f10 : f5;
+}
+
+// ---- paired timing ----
+
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+struct Row {
+  std::string stage, frame;
+  std::size_t points_in = 0;
+  // Medians of the thread's CPU time (us): warm = runs that follow a run of the same side, cold = the first
+  // run after the other side's; and of the wall time of the warm runs.
+  double ours_cpu = 0, pcl_cpu = 0, ours_cold = 0, pcl_cold = 0, ours_wall = 0, pcl_wall = 0;
+};
+std::vector<Row>& rows() {
+  static std::vector<Row> r;
+  return r;
+}
+
+// Every iteration runs ours kRuns times, then PCL's kRuns times, on the same input. The first run of each
+// side follows the other side's runs (its caches and branch history are the other's: cold); the rest follow
+// their own (warm). `pcl` may be empty (no stock-PCL counterpart).
+constexpr int kRuns = 3;
+void paired(benchmark::State& state, const std::string& stage, int which, std::size_t points_in,
+            const std::function<void()>& ours, const std::function<void()>& pcl) {
+  std::vector<double> o_cpu, p_cpu, o_cold, p_cold, o_wall, p_wall;
+  using clock = std::chrono::steady_clock;
+  const auto timed = [](const std::function<void()>& f, double& cpu_us, double& wall_us) {
+    const auto t0 = clock::now();
+    const double c0 = cpu_seconds();
+    f();
+    cpu_us = (cpu_seconds() - c0) * 1e6;
+    wall_us = std::chrono::duration<double>(clock::now() - t0).count() * 1e6;
+  };
+  for (auto _ : state) {
+    double manual = 0.0;
+    for (int r = 0; r < kRuns; ++r) {
+      double cpu = 0, wall = 0;
+      timed(ours, cpu, wall);
+      manual += wall * 1e-6;
+      (r == 0 ? o_cold : o_cpu).push_back(cpu);
+      if (r > 0) o_wall.push_back(wall);
+    }
+    state.SetIterationTime(manual / kRuns);
+    if (!pcl) continue;
+    for (int r = 0; r < kRuns; ++r) {
+      double cpu = 0, wall = 0;
+      timed(pcl, cpu, wall);
+      (r == 0 ? p_cold : p_cpu).push_back(cpu);
+      if (r > 0) p_wall.push_back(wall);
+    }
+  }
+  Row row{stage,          frame(which).name, points_in,      median(o_cpu), median(p_cpu),
+          median(o_cold), median(p_cold),    median(o_wall), median(p_wall)};
+  state.counters["points_in"] = static_cast<double>(points_in);
+  state.counters["ours_us"] = row.ours_cpu;
+  state.counters["ours_cold_us"] = row.ours_cold;
+  if (pcl) {
+    state.counters["pcl_us"] = row.pcl_cpu;
+    state.counters["pcl_cold_us"] = row.pcl_cold;
+    state.counters["x_faster_than_pcl"] = row.ours_cpu > 0 ? row.pcl_cpu / row.ours_cpu : 0.0;
+    state.counters["x_faster_cold"] = row.ours_cold > 0 ? row.pcl_cold / row.ours_cold : 0.0;
+  }
+  // Google Benchmark calls a benchmark several times while it sizes the run: keep the last, the real one.
+  auto& all = rows();
+  const auto same = [&row](const Row& x) { return x.stage == row.stage && x.frame == row.frame; };
+  const auto it = std::find_if(all.begin(), all.end(), same);
+  if (it != all.end()) {
+    *it = row;
+  } else {
+    all.push_back(row);
+  }
+}
+
+// ---- the benchmarks ----
+
+void BM_Crop(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const PipelineParams& p = published();
+  Cloud out;
+  PclCloud pout;
+  paired(
+      state, "crop (ROI + body)", static_cast<int>(state.range(0)), f.points.size(),
+      [&] {
+        crop_box(f.points, p.roi, p.body, out);
+        benchmark::DoNotOptimize(out.x.data());
+      },
+      [&] { pcl_crop(f.pcl_points, pout, p); });
+}
+
+void BM_Voxel(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  VoxelGrid grid(published().voxel);
+  Cloud out;
+  PclCloud pout;
+  paired(
+      state, "voxel grid 0.15 m", static_cast<int>(state.range(0)), f.cropped.size(),
+      [&] {
+        grid.filter(f.cropped, out);
+        benchmark::DoNotOptimize(out.x.data());
+      },
+      [&] { pcl_voxel(f.pcl_cropped, pout, 0.15); });
+}
+
+void BM_GroundRansac(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const PipelineParams& p = published();
+  RansacGround ransac(p.ground.ransac, 0.95);
+  GroundLabels labels;
+  pcl::PointIndices inliers;
+  paired(
+      state, "ground: RANSAC plane", static_cast<int>(state.range(0)), f.voxels.size(),
+      [&] {
+        ransac.segment(f.voxels, labels);
+        benchmark::DoNotOptimize(labels.ground.data());
+      },
+      [&] { pcl_ground(f.pcl_voxels, inliers, p.ground.ransac.iterations, p.ground.ransac.distance_m); });
+}
+
+void BM_GroundZones(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const PipelineParams& p = published();
+  ZoneGround zones(fieldguard_params().ground.zones);
+  GroundLabels labels;
+  pcl::PointIndices inliers;
+  paired(
+      state, "ground: zones (vs PCL RANSAC)", static_cast<int>(state.range(0)), f.voxels.size(),
+      [&] {
+        zones.segment(f.voxels, labels);
+        benchmark::DoNotOptimize(labels.ground.data());
+      },
+      [&] { pcl_ground(f.pcl_voxels, inliers, p.ground.ransac.iterations, p.ground.ransac.distance_m); });
+}
+
+void cluster_bench(benchmark::State& state, const char* stage, ClusterMethod m, ClusterStructure s) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  ClusterParams cp = fieldguard_params().cluster;
+  cp.method = m;
+  cp.structure = s;
+  cp.tolerance_m = 0.6;
+  EuclideanClusterer clusterer(cp);
+  Clusters out;
+  paired(
+      state, stage, static_cast<int>(state.range(0)), f.above.size(),
+      [&] {
+        clusterer.extract(f.above, out);
+        benchmark::DoNotOptimize(out.indices.data());
+      },
+      [&] { pcl_clusters(f.pcl_above, 0.6, 1, 1000000); });
+}
+void BM_ClusterFixedKdTree(benchmark::State& state) {
+  cluster_bench(state, "cluster: fixed 0.6, k-d tree", ClusterMethod::Fixed, ClusterStructure::KdTree);
+}
+void BM_ClusterFixedGrid(benchmark::State& state) {
+  cluster_bench(state, "cluster: fixed 0.6, grid", ClusterMethod::Fixed, ClusterStructure::Grid);
+}
+void BM_ClusterAdaptiveGrid(benchmark::State& state) {
+  cluster_bench(state, "cluster: adaptive, grid", ClusterMethod::Adaptive, ClusterStructure::Grid);
+}
+
+void pipeline_bench(benchmark::State& state, const char* stage, const PipelineParams& params) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  Pipeline pipe(params);
+  paired(
+      state, stage, static_cast<int>(state.range(0)), f.points.size(),
+      [&] {
+        const auto r = pipe.process(f.points);
+        benchmark::DoNotOptimize(r.obstacles.data());
+      },
+      [&] { benchmark::DoNotOptimize(pcl_pipeline(f.pcl_points)); });
+}
+void BM_PipelinePublished(benchmark::State& state) { pipeline_bench(state, "PIPELINE published.yaml", published()); }
+void BM_PipelineFieldguard(benchmark::State& state) {
+  pipeline_bench(state, "PIPELINE fieldguard.yaml", fieldguard_params());
+}
+
+constexpr double kMinTime = 0.5;  // seconds of our own (manual) time per benchmark
+#define FG_BENCH(fn) BENCHMARK(fn)->Arg(0)->Arg(1)->UseManualTime()->MinTime(kMinTime)->Unit(benchmark::kMicrosecond)
+FG_BENCH(BM_Crop);
+FG_BENCH(BM_Voxel);
+FG_BENCH(BM_GroundRansac);
+FG_BENCH(BM_GroundZones);
+FG_BENCH(BM_ClusterFixedKdTree);
+FG_BENCH(BM_ClusterFixedGrid);
+FG_BENCH(BM_ClusterAdaptiveGrid);
+FG_BENCH(BM_PipelinePublished);
+FG_BENCH(BM_PipelineFieldguard);
+
+void print_summary() {
+  if (rows().empty()) return;
+  std::printf("\nFrames: 10Hz %zu points (%s), 5Hz %zu points (%s).\n", frame(0).points.size(),
+              frame_file(0).empty() ? "synthetic HDL-32E, benchmarks/synthetic_scene.hpp" : frame_file(0).c_str(),
+              frame(1).points.size(),
+              frame_file(1).empty() ? "synthetic HDL-32E, benchmarks/synthetic_scene.hpp" : frame_file(1).c_str());
+  std::printf(
+      "Medians of thread CPU time in us. warm: runs after a run of the same side; cold: the first run\n"
+      "after the other side's (caches and branch history theirs). PCL: the stock classes, same input.\n");
+  std::printf("%-30s %-5s %7s | %8s %8s %6s | %8s %8s %6s | %8s %8s\n", "stage", "frame", "pts in", "ours", "pcl",
+              "x warm", "ours", "pcl", "x cold", "ours wall", "pcl wall");
+  for (const Row& r : rows()) {
+    if (r.pcl_cpu > 0.0) {
+      std::printf("%-30s %-5s %7zu | %8.1f %8.1f %6.2f | %8.1f %8.1f %6.2f | %8.1f %8.1f\n", r.stage.c_str(),
+                  r.frame.c_str(), r.points_in, r.ours_cpu, r.pcl_cpu, r.pcl_cpu / r.ours_cpu, r.ours_cold, r.pcl_cold,
+                  r.pcl_cold / r.ours_cold, r.ours_wall, r.pcl_wall);
+    } else {
+      std::printf("%-30s %-5s %7zu | %8.1f %8s %6s | %8.1f %8s %6s | %8.1f %8s\n", r.stage.c_str(), r.frame.c_str(),
+                  r.points_in, r.ours_cpu, "-", "-", r.ours_cold, "-", "-", r.ours_wall, "-");
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Our own flags first (Google Benchmark refuses flags it does not know).
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--frame10=", 0) == 0) {
+      frame_file(0) = a.substr(10);
+    } else if (a.rfind("--frame5=", 0) == 0) {
+      frame_file(1) = a.substr(9);
+    } else {
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  print_summary();
+  return 0;
+}

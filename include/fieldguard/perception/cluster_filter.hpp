@@ -1,0 +1,46 @@
+#pragma once
+// Which clusters are obstacles: point count (its minimum falling with distance when configured), box volume,
+// and height above the local ground (clods, ridges and furrows below it are terrain).
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/params.hpp"
+
+namespace fieldguard::perception {
+
+struct ClusterSummary {
+  std::uint32_t points = 0;
+  std::array<float, 3> min{};  // axis-aligned box (m)
+  std::array<float, 3> max{};
+  float distance_m = 0.F;             // horizontal distance from the sensor to the nearest point
+  float height_above_ground_m = 0.F;  // of the highest point above its local ground
+  bool ground_guessed = false;        // every point stands on guessed ground (GroundLabels::guessed)
+  [[nodiscard]] float volume_m3() const { return (max[0] - min[0]) * (max[1] - min[1]) * (max[2] - min[2]); }
+};
+
+enum class Rejection : std::uint8_t { Kept = 0, TooFewPoints, TooManyPoints, TooSmall, TooLarge, TooLow };
+[[nodiscard]] std::string_view to_string(Rejection r);
+
+// `height_m`: every cloud point's height above its local ground; `guessed`: 1 where that ground is a guess
+// (empty: none is).
+[[nodiscard]] ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m,
+                                       std::span<const std::uint8_t> guessed, std::span<const std::uint32_t> indices);
+
+// Where no ground was measured under a cluster (ground_guessed), its height above ground is a guess too: three
+// flat returns of one ring far out are as likely the ground as anything standing on it. Such a cluster's
+// height is then no more than it shows itself: from `floor_z` (its lowest point, or a lower ground-labelled
+// point under it, such as a person's feet) to its top.
+void limit_height_to_extent(ClusterSummary& s, float floor_z);
+
+// The least point count of a cluster at `distance_m`: min_points, or beyond min_points_full_range_m
+// min_points * (full_range / d)^2 rounded up, but not below min_points_floor.
+[[nodiscard]] std::uint32_t min_points_at(const FilterParams& f, float distance_m);
+
+// Bounds are inclusive: a cluster of exactly min_points points, or exactly min_volume_m3, is kept.
+[[nodiscard]] Rejection check_cluster(const FilterParams& f, const ClusterSummary& s);
+
+}  // namespace fieldguard::perception

@@ -1,0 +1,76 @@
+#pragma once
+// Euclidean clustering: the connected components of the graph that joins two points nearer than the
+// clustering radius, as pcl::EuclideanClusterExtraction finds them (breadth-first from the lowest
+// unclustered index, radius searches, a point joins once).
+//
+// Fixed: one radius (d^2 < r^2 in float, as pcl::search::KdTree). Adaptive: each point has its radius from its
+// 3D range (ClusterParams); two points join when nearer than the larger of their two radii, which is
+// symmetric, so the clusters do not depend on the search order. Structures: KdTree (our k-d tree, the
+// published way) or Grid (points counting-sorted into x-y columns of the smallest radius; a search scans the
+// neighbouring columns, skipping those already taken). Both find exactly the same clusters.
+// Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
+// point index, indices ascending within a cluster. Thread-compatible.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/kdtree.hpp"
+#include "fieldguard/perception/params.hpp"
+
+namespace fieldguard::perception {
+
+struct Clusters {
+  Buffer<std::uint32_t> indices;  // point indices grouped by cluster
+  Buffer<std::uint32_t> offsets;  // cluster c is indices[offsets[c], offsets[c + 1])
+  [[nodiscard]] std::size_t size() const { return offsets.empty() ? 0 : offsets.size() - 1; }
+  [[nodiscard]] std::span<const std::uint32_t> operator[](std::size_t c) const {
+    return {indices.data() + offsets[c], offsets[c + 1] - offsets[c]};
+  }
+};
+
+class EuclideanClusterer {
+ public:
+  // Throws std::invalid_argument for a radius that is not positive, or an adaptive growth of 0.5 m per metre
+  // of range or more.
+  explicit EuclideanClusterer(const ClusterParams& params);
+
+  void extract(const Cloud& in, Clusters& out);
+
+  // The clustering radius of a point at 3D range `range_m` (the fixed radius when not adaptive).
+  [[nodiscard]] float radius_at(float range_m) const;
+  [[nodiscard]] const ClusterParams& params() const { return params_; }
+
+ private:
+  void prepare(const Cloud& in);
+  void extract_kdtree(const Cloud& in, Clusters& out);
+  void extract_grid(const Cloud& in, Clusters& out);
+  void finish_cluster(Clusters& out);
+
+  ClusterParams params_;
+  float base_r2_ = 0.F;  // fixed radius squared, as PCL rounds it
+  float growth_ = 0.F;   // adaptive: radius per metre of range
+  float cap_ = 0.F;      // adaptive radius cap
+  bool adaptive_ = false;
+
+  KdTree tree_;
+  // Scratch, reused across frames.
+  Buffer<float> r2_;     // per point (adaptive): its radius squared
+  Buffer<float> query_;  // per point: the search radius that finds every neighbour
+  Buffer<std::uint8_t> done_;
+  Buffer<std::uint32_t> queue_;
+  Buffer<std::uint32_t> pos_of_;  // cloud index -> position in the structure's order
+  Buffer<std::uint32_t> col_start_;
+  Buffer<std::uint32_t> cell_of_;
+  struct GridPoint {
+    float x, y, z;
+    std::uint32_t index;
+  };
+  Buffer<GridPoint> grid_points_;
+  Buffer<float> sorted_r2_;         // r2_ in grid order
+  Buffer<std::uint32_t> grid_col_;  // column of each point in grid order
+  Buffer<std::uint32_t> col_left_;  // per column: points not yet in a cluster
+};
+
+}  // namespace fieldguard::perception

@@ -1,0 +1,40 @@
+#pragma once
+// The boxes of an obstacle: the minimum-area rectangle of a footprint (2D convex hull, then every hull edge
+// as a side: the minimum-area enclosing rectangle has a side on the hull, Freeman & Shapira 1975), and the
+// size class.
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "fieldguard/perception/obstacle.hpp"
+
+namespace fieldguard::perception {
+
+// Person-sized: fits in kSmallFootprint_m x kSmallFootprint_m x kSmallHeight_m.
+inline constexpr float kSmallFootprint_m = 1.2F;
+inline constexpr float kSmallHeight_m = 2.2F;
+
+struct OrientedRect {
+  std::array<float, 2> center{};  // m
+  float length_m = 0.F;           // the longer side, along yaw
+  float width_m = 0.F;
+  float yaw_rad = 0.F;  // of the length axis from x, counter-clockwise, in (-pi/2, pi/2]
+};
+
+// Convex hull of `pts` counter-clockwise without collinear points, from the lowest-leftmost point (Andrew's
+// monotone chain). `scratch` is working space.
+void convex_hull(std::span<const std::array<float, 2>> pts, std::vector<std::array<float, 2>>& hull,
+                 std::vector<std::array<float, 2>>& scratch);
+
+// Minimum-area rectangle around `pts`; `hull` and `scratch` are working space. One point: a rectangle of size
+// zero at it; collinear points: width zero. Among rectangles within 1 % of the least area, the one whose sides
+// carry the most points (two faces seen at a corner make a right-triangle hull, whose leg- and
+// hypotenuse-aligned rectangles have the same area); remaining ties keep the first hull edge (deterministic).
+[[nodiscard]] OrientedRect min_area_rect(std::span<const std::array<float, 2>> pts,
+                                         std::vector<std::array<float, 2>>& hull,
+                                         std::vector<std::array<float, 2>>& scratch);
+
+[[nodiscard]] SizeClass size_class(float length_m, float width_m, float height_m);
+
+}  // namespace fieldguard::perception

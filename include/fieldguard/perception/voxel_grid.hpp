@@ -1,0 +1,81 @@
+#pragma once
+// Voxel grid downsampling: every occupied voxel becomes the centroid of its points (as pcl::VoxelGrid,
+// whose grid is anchored at the origin: voxel i spans [i*leaf, (i+1)*leaf) on each axis). Optionally a
+// coarser leaf with range (VoxelParams::coarse_from_m).
+//
+// Fast: voxel keys packed in 64 bits, in a flat open-addressing hash table of 4-byte voxel ids (linear
+// probing; ids offset per frame, so nothing is cleared between frames; small, so that it stays in cache
+// while the rotation streams past); in front of it a per-ring cache of the last
+// voxel with its running sums (a ring's consecutive returns usually share a voxel: 85 % of an HDL-32E
+// rotation's points never reach the table); finished runs meet the table in batches, with the memory they
+// need fetched ahead. Output in the order the voxels' first runs finished, which, as every sum's order,
+// depends only on the input: deterministic.
+// Thread-compatible: one VoxelGrid per thread (it owns its scratch).
+
+#include <array>
+#include <cstdint>
+
+#include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/params.hpp"
+
+namespace fieldguard::perception {
+
+class VoxelGrid {
+ public:
+  // Throws std::invalid_argument for a leaf that is not positive.
+  explicit VoxelGrid(const VoxelParams& params);
+
+  // `out` gets the centroids (no rings). `in` and `out` must be different clouds.
+  void filter(const Cloud& in, Cloud& out);
+
+  [[nodiscard]] const VoxelParams& params() const { return params_; }
+
+ private:
+  struct Sum {
+    float x, y, z;
+    std::uint32_t n;
+  };
+  using Vec4 = float __attribute__((vector_size(16)));  // = simd::f32x4 (src/perception/simd.hpp)
+  struct CacheEntry {
+    Vec4 sum;  // x, y, z, (unused)
+    std::uint64_t key;
+    std::uint32_t n;
+  };
+  struct Run {  // a ring's points in one voxel, waiting for the table
+    Vec4 sum;
+    std::uint64_t key;
+    std::uint32_t n;
+    std::uint32_t id;
+  };
+  static constexpr std::size_t kRingCache = 128;
+  static constexpr std::uint32_t kRunBatch = 64;
+
+  void begin(std::size_t max_points);
+  void add(std::uint64_t key, std::uint32_t ring, Vec4 p);
+  void add_points(const float* x, const float* y, const float* z, const std::uint16_t* ring, std::size_t n);
+  void queue_run(const CacheEntry& c);
+  void drain_runs();
+  void finish(Cloud& out);
+  void grow_table();
+  [[nodiscard]] std::uint32_t find_or_insert(std::uint64_t key);
+  [[nodiscard]] std::uint64_t coarse_key(float x, float y, float z) const;
+
+  VoxelParams params_;
+  bool coarse_ = false;
+  std::uint32_t bands_ = 1;
+  std::array<float, 16> inv_{};  // inverse leaf per band (1-based)
+  float inv_band_range_ = 0.F;
+
+  Buffer<std::uint32_t> table_;  // voxel id + base_, or anything else when empty
+  std::uint32_t mask_ = 0;
+  std::uint32_t shift_ = 0;
+  std::uint32_t base_ = 1;
+  Buffer<Sum> sums_;
+  Buffer<std::uint64_t> keys_;  // key of each voxel id, for growing the table
+  std::uint32_t voxels_ = 0;
+  std::array<CacheEntry, kRingCache> cache_{};
+  std::array<Run, kRunBatch> runs_{};
+  std::uint32_t queued_ = 0;
+};
+
+}  // namespace fieldguard::perception

@@ -1,0 +1,92 @@
+#pragma once
+// Ground that holds on real fields: local planes on a polar grid of concentric zones (after Patchwork++'s
+// concentric zone model), each bin's plane grown out of the plane of the bin inside it.
+//
+// Bins are visited from the sensor outwards. A bin's prior is the plane of the bin just inside it (for the
+// innermost ring: one plane fitted to that whole ring, starting level at -sensor_height). Seeds are the bin's
+// lowest points measured along the prior's slope; a plane z = a x + b y + c is fitted to them by least
+// squares with the prior's slope as a prior (so a bin seen by one scan ring, whose points hardly spread across
+// the ring, keeps the slope of the bin inside it and fits only its height), then refitted to the points near it. The
+// bin keeps its own plane only when it is a ground plane: not steeper than max_slope_deg, its points spread over at
+// least min_spread_m (a person's legs do not), and its height continues the prior's (within max_step_m plus the rise of
+// max_slope_change_deg over the distance between them: a haystack, a crop block, a building do not). Otherwise it
+// continues the prior's plane; and once every bin is done, a bin without its own plane gets the planes of the fitted
+// bins inside and outside it blended by distance. Every point then gets its height above its bin's plane; below
+// ground_threshold_m it is ground. The surface is kept, so ground_z(x, y) answers for any (x, y).
+// Thread-compatible.
+
+#include <cstdint>
+#include <vector>
+
+#include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/ground.hpp"
+#include "fieldguard/perception/params.hpp"
+
+namespace fieldguard::perception {
+
+class ZoneGround {
+ public:
+  // Throws std::invalid_argument for a zone layout that is not one (edges not increasing, list lengths that
+  // do not match, no rings or sectors).
+  explicit ZoneGround(const ZoneParams& params);
+
+  void segment(const Cloud& in, GroundLabels& out);
+
+  // The local ground of the last frame under (x, y): the plane of the bin (x, y) falls in.
+  [[nodiscard]] GroundPlane plane_at(float x, float y) const;
+  [[nodiscard]] float ground_z(float x, float y) const { return plane_at(x, y).z_at(x, y); }
+  // True when that bin's plane was fitted to its own points (not continued from the bin inside it).
+  [[nodiscard]] bool fitted_at(float x, float y) const;
+  // How far that bin's ground is from where it was measured (0 for a fitted bin, m).
+  [[nodiscard]] float support_at(float x, float y) const;
+  [[nodiscard]] std::size_t bin_count() const { return bins_.size(); }
+  [[nodiscard]] std::uint32_t bin_of(float x, float y) const;
+  [[nodiscard]] std::uint32_t bin_of_polar(float r, float theta) const;
+
+ private:
+  struct Zone {
+    float r0, r1;  // m
+    float inv_ring_width;
+    std::uint32_t rings, sectors, first_bin;
+    float sector_scale;          // sectors / (2 pi)
+    float max_ring, max_sector;  // just below rings, sectors
+  };
+  struct Bin {
+    GroundPlane plane;
+    float ref_x = 0.F, ref_y = 0.F;  // where the plane was last fitted (its points' centroid)
+    float center_x = 0.F, center_y = 0.F;
+    float support_m = 0.F;  // from the centre to the nearest place a plane it uses was fitted
+    bool fitted = false;
+  };
+  struct Fit {
+    GroundPlane plane;
+    float mean_x = 0.F, mean_y = 0.F;
+    std::uint32_t count = 0;
+    float spread = 0.F;
+  };
+
+  GroundPlane fit_innermost(const Cloud& in);
+  void fit_bin(std::uint32_t bin, const Bin& prior);
+  [[nodiscard]] Fit least_squares(const GroundPlane& sel, float lo, float hi, const GroundPlane& prior,
+                                  double prior_per_point) const;
+  void gather(const Cloud& in, std::uint32_t k0, std::uint32_t k1);
+  void interpolate_gaps();
+
+  ZoneParams params_;
+  std::vector<Zone> zones_;
+  static constexpr std::uint32_t kNoBin = 0xFFFFFFFFU;
+  std::vector<Bin> bins_;
+  std::vector<std::uint32_t> inner_, outer_;  // per bin: the bin just inside / outside it, or kNoBin
+  std::vector<GroundPlane> filled_;
+  float sensor_height_m_;
+  float tan_max_slope_ = 0.F, tan_max_tilt_ = 0.F, tan_max_change_ = 0.F;
+  // Scratch, reused across frames.
+  Buffer<std::uint32_t> bin_of_point_;
+  Buffer<std::uint32_t> bin_start_;
+  Buffer<std::uint32_t> order_;
+  Buffer<std::uint32_t> cursor_;
+  Buffer<float> bx_, by_, bz_, resid_, tmp_;  // the bin's points (padded), and scratch
+  std::size_t bin_n_ = 0;                     // points in bx_ .. bz_ before the padding
+};
+
+}  // namespace fieldguard::perception

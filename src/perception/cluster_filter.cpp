@@ -1,0 +1,74 @@
+#include "fieldguard/perception/cluster_filter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fieldguard::perception {
+
+std::string_view to_string(Rejection r) {
+  switch (r) {
+    case Rejection::Kept: return "kept";
+    case Rejection::TooFewPoints: return "too few points";
+    case Rejection::TooManyPoints: return "too many points";
+    case Rejection::TooSmall: return "box too small";
+    case Rejection::TooLarge: return "box too large";
+    case Rejection::TooLow: return "too low above the ground";
+  }
+  return "?";
+}
+
+ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
+                         std::span<const std::uint32_t> indices) {
+  ClusterSummary s;
+  if (indices.empty()) return s;
+  constexpr float kBig = std::numeric_limits<float>::max();
+  float lo[3] = {kBig, kBig, kBig}, hi[3] = {-kBig, -kBig, -kBig};
+  float r2 = kBig, top = -kBig;
+  bool all_guessed = !guessed.empty();
+  for (const std::uint32_t i : indices) {
+    all_guessed = all_guessed && guessed[i] != 0U;
+    const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
+    lo[0] = std::min(lo[0], x);
+    hi[0] = std::max(hi[0], x);
+    lo[1] = std::min(lo[1], y);
+    hi[1] = std::max(hi[1], y);
+    lo[2] = std::min(lo[2], z);
+    hi[2] = std::max(hi[2], z);
+    r2 = std::min(r2, x * x + y * y);
+    top = std::max(top, height_m[i]);
+  }
+  s.points = static_cast<std::uint32_t>(indices.size());
+  s.min = {lo[0], lo[1], lo[2]};
+  s.max = {hi[0], hi[1], hi[2]};
+  s.distance_m = std::sqrt(r2);
+  s.height_above_ground_m = top;
+  s.ground_guessed = all_guessed;
+  return s;
+}
+
+void limit_height_to_extent(ClusterSummary& s, float floor_z) {
+  if (!s.ground_guessed) return;
+  s.height_above_ground_m = std::min(s.height_above_ground_m, s.max[2] - std::min(floor_z, s.min[2]));
+}
+
+std::uint32_t min_points_at(const FilterParams& f, float distance_m) {
+  const auto full = static_cast<std::uint32_t>(std::max(f.min_points, 0));
+  if (!(f.min_points_full_range_m > 0.0) || !(static_cast<double>(distance_m) > f.min_points_full_range_m)) return full;
+  const double ratio = f.min_points_full_range_m / static_cast<double>(distance_m);
+  const auto scaled = static_cast<std::uint32_t>(std::ceil(static_cast<double>(full) * ratio * ratio - 1e-9));
+  const auto floor = static_cast<std::uint32_t>(std::max(f.min_points_floor, 0));
+  return std::min(full, std::max(floor, scaled));
+}
+
+Rejection check_cluster(const FilterParams& f, const ClusterSummary& s) {
+  if (s.points < min_points_at(f, s.distance_m)) return Rejection::TooFewPoints;
+  if (f.max_points > 0 && s.points > static_cast<std::uint32_t>(f.max_points)) return Rejection::TooManyPoints;
+  const double v = s.volume_m3();
+  if (v < f.min_volume_m3) return Rejection::TooSmall;
+  if (f.max_volume_m3 > 0.0 && v > f.max_volume_m3) return Rejection::TooLarge;
+  if (f.min_height_m > 0.0 && static_cast<double>(s.height_above_ground_m) < f.min_height_m) return Rejection::TooLow;
+  return Rejection::Kept;
+}
+
+}  // namespace fieldguard::perception

@@ -1,0 +1,161 @@
+#include "fieldguard/perception/pipeline.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+
+#include "fieldguard/perception/cluster_filter.hpp"
+#include "fieldguard/perception/crop.hpp"
+#include "fieldguard/perception/euclidean_cluster.hpp"
+#include "fieldguard/perception/obstacle_box.hpp"
+#include "fieldguard/perception/ransac_ground.hpp"
+#include "fieldguard/perception/voxel_grid.hpp"
+#include "fieldguard/perception/zone_ground.hpp"
+
+namespace fieldguard::perception {
+
+struct Pipeline::Impl {
+  explicit Impl(const PipelineParams& p) : params(p), voxel(p.voxel), clusterer(p.cluster) {
+    if (p.roi.min[0] >= p.roi.max[0] || p.roi.min[1] >= p.roi.max[1] || p.roi.min[2] >= p.roi.max[2]) {
+      throw std::invalid_argument("Pipeline: the ROI box needs min < max on every axis");
+    }
+    if (p.ground.method == GroundMethod::Ransac) {
+      ransac.emplace(p.ground.ransac, p.ground.zones.sensor_height_m);
+    } else {
+      zones.emplace(p.ground.zones);
+    }
+  }
+
+  PipelineParams params;
+  VoxelGrid voxel;
+  std::optional<RansacGround> ransac;
+  std::optional<ZoneGround> zones;
+  EuclideanClusterer clusterer;
+
+  Cloud cropped, voxels, above;
+  GroundLabels ground;
+  Buffer<std::uint32_t> above_index;  // index in `voxels` of each point of `above`
+  Buffer<float> above_height;
+  Buffer<std::uint8_t> above_guessed;
+  Clusters clusters;
+  std::vector<LabeledPoint> labeled;
+  std::vector<std::array<float, 2>> footprint, hull, hull_scratch;
+};
+
+Pipeline::Pipeline(const PipelineParams& params) : impl_(std::make_unique<Impl>(params)) {}
+Pipeline::~Pipeline() = default;
+Pipeline::Pipeline(Pipeline&&) noexcept = default;
+Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
+
+const PipelineParams& Pipeline::params() const { return impl_->params; }
+
+std::span<const LabeledPoint> Pipeline::last_points() const { return impl_->labeled; }
+
+float Pipeline::ground_z(float x, float y) const {
+  return impl_->ransac ? impl_->ransac->ground_z(x, y) : impl_->zones->ground_z(x, y);
+}
+
+FrameResult Pipeline::process(std::span<const LidarPoint> points) {
+  Impl& m = *impl_;
+  FrameResult result;
+  result.counts.input = static_cast<std::uint32_t>(points.size());
+
+  // ROI and body box, then the voxel grid. (One pass doing both measured no faster: the cropped cloud stays
+  // in cache between the two.)
+  crop_box(points, m.params.roi, m.params.body, m.cropped);
+  result.counts.after_roi = static_cast<std::uint32_t>(m.cropped.size());
+  m.voxel.filter(m.cropped, m.voxels);
+  const std::size_t n = m.voxels.size();
+  result.counts.after_voxel = static_cast<std::uint32_t>(n);
+
+  if (m.ransac) {
+    m.ransac->segment(m.voxels, m.ground);
+  } else {
+    m.zones->segment(m.voxels, m.ground);
+  }
+
+  // Everything that is not ground goes on to clustering.
+  m.above.clear();
+  m.above_index.clear();
+  m.above_height.clear();
+  m.above_guessed.clear();
+  m.labeled.resize(n);
+  std::uint32_t ground_count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool g = m.ground.ground[i] != 0U;
+    m.labeled[i] =
+        LabeledPoint{m.voxels.x[i], m.voxels.y[i], m.voxels.z[i], g ? PointLabel::Ground : PointLabel::Unclustered};
+    if (g) {
+      ++ground_count;
+      continue;
+    }
+    m.above.push_back(m.voxels.x[i], m.voxels.y[i], m.voxels.z[i]);
+    m.above_index.push_back(static_cast<std::uint32_t>(i));
+    m.above_height.push_back(m.ground.height_m[i]);
+    m.above_guessed.push_back(m.ground.guessed[i]);
+  }
+  result.counts.ground = ground_count;
+
+  m.clusterer.extract(m.above, m.clusters);
+
+  const FilterParams& f = m.params.filters;
+  for (std::size_t c = 0; c < m.clusters.size(); ++c) {
+    const auto members = m.clusters[c];
+    ClusterSummary s = summarize(m.above, m.above_height, m.above_guessed, members);
+    Rejection why = check_cluster(f, s);
+    if (s.ground_guessed && why == Rejection::Kept) {
+      // No ground measured under it: its height is what it shows, from the lowest point under its footprint
+      // (ground-labelled points under it may be its own feet) to its top. (Only a kept cluster can change:
+      // this lowers the height.)
+      constexpr float kMargin = 0.25F;  // m around the footprint
+      float floor_z = s.min[2];
+      for (std::size_t i = 0; i < n; ++i) {
+        if (m.ground.ground[i] == 0U) continue;
+        const float x = m.voxels.x[i], y = m.voxels.y[i];
+        if (x >= s.min[0] - kMargin && x <= s.max[0] + kMargin && y >= s.min[1] - kMargin && y <= s.max[1] + kMargin) {
+          floor_z = std::min(floor_z, m.voxels.z[i]);
+        }
+      }
+      limit_height_to_extent(s, floor_z);
+      why = check_cluster(f, s);
+    }
+    // Too few points for its distance: not a cluster at all (PCL's minimum cluster size), left unclustered.
+    if (why == Rejection::TooFewPoints) continue;
+    ++result.counts.clusters;
+    const PointLabel label = why == Rejection::Kept ? PointLabel::Obstacle : PointLabel::Rejected;
+    for (const std::uint32_t i : members) m.labeled[m.above_index[i]].label = label;
+    if (why != Rejection::Kept) continue;
+
+    Obstacle o;
+    o.min = s.min;
+    o.max = s.max;
+    o.points = s.points;
+    o.distance_m = s.distance_m;
+    o.height_above_ground_m = s.height_above_ground_m;
+    const float cx = 0.5F * (s.min[0] + s.max[0]), cy = 0.5F * (s.min[1] + s.max[1]);
+    o.bearing_deg =
+        static_cast<float>(std::atan2(static_cast<double>(cy), static_cast<double>(cx)) * 180.0 / std::numbers::pi);
+    m.footprint.clear();
+    for (const std::uint32_t i : members) m.footprint.push_back({m.above.x[i], m.above.y[i]});
+    const OrientedRect r = min_area_rect(m.footprint, m.hull, m.hull_scratch);
+    o.obb_center = r.center;
+    o.obb_length_m = r.length_m;
+    o.obb_width_m = r.width_m;
+    o.obb_yaw_rad = r.yaw_rad;
+    o.size_class = size_class(r.length_m, r.width_m, s.max[2] - s.min[2]);
+    result.obstacles.push_back(o);
+  }
+  result.counts.obstacles = static_cast<std::uint32_t>(result.obstacles.size());
+
+  std::sort(result.obstacles.begin(), result.obstacles.end(), [](const Obstacle& a, const Obstacle& b) {
+    if (a.distance_m != b.distance_m) return a.distance_m < b.distance_m;
+    if (a.bearing_deg != b.bearing_deg) return a.bearing_deg < b.bearing_deg;
+    return a.min < b.min;
+  });
+  return result;
+}
+
+}  // namespace fieldguard::perception

@@ -1,0 +1,241 @@
+#include "fieldguard/perception/voxel_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "perception/simd.hpp"
+
+namespace fieldguard::perception {
+namespace {
+
+constexpr std::uint32_t kNoVoxel = 0xFFFFFFFFU;
+// Voxel coordinates are packed in 20 bits each (offset by 2^19), the range band in the top 4 bits, so no key
+// is all ones: that marks an empty ring-cache entry.
+constexpr std::int32_t kCoordOffset = 1 << 19;
+constexpr float kCoordLimit = 524287.0F;  // 2^19 - 1: coordinates beyond are clamped (5 km at a 1 cm leaf)
+constexpr std::uint32_t kMaxBands = 15;
+constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+
+// floor() to int for the voxel index, as pcl::VoxelGrid's static_cast<int>(std::floor(x * inverse_leaf)),
+// without the libm call; NaN maps to the lower bound.
+inline std::int32_t voxel_coord(float v) {
+  v = v >= -kCoordLimit ? v : -kCoordLimit;
+  v = v <= kCoordLimit ? v : kCoordLimit;
+  const auto i = static_cast<std::int32_t>(v);
+  return i - static_cast<std::int32_t>(v < static_cast<float>(i));
+}
+
+inline std::uint64_t pack(std::int32_t ix, std::int32_t iy, std::int32_t iz, std::uint32_t band) {
+  return (static_cast<std::uint64_t>(band) << 60U) | (static_cast<std::uint64_t>(ix + kCoordOffset) << 40U) |
+         (static_cast<std::uint64_t>(iy + kCoordOffset) << 20U) | static_cast<std::uint64_t>(iz + kCoordOffset);
+}
+
+constexpr std::size_t kBlock = 8;  // points whose keys are computed together
+
+// Keys of kBlock points with one leaf (inverse `s`), four at a time, clamped to the key's range.
+inline void block_keys(const float* x, const float* y, const float* z, float s, std::uint64_t* keys) {
+  const simd::f32x4 sv = simd::splat(s);
+  for (std::size_t b = 0; b < kBlock; b += 4) {
+    const simd::i32x4 ix = simd::floor_clamped(simd::load(x + b) * sv, kCoordLimit);
+    const simd::i32x4 iy = simd::floor_clamped(simd::load(y + b) * sv, kCoordLimit);
+    const simd::i32x4 iz = simd::floor_clamped(simd::load(z + b) * sv, kCoordLimit);
+    std::int32_t vx[4], vy[4], vz[4];
+    std::memcpy(vx, &ix, sizeof vx);
+    std::memcpy(vy, &iy, sizeof vy);
+    std::memcpy(vz, &iz, sizeof vz);
+    for (std::size_t k = 0; k < 4; ++k) keys[b + k] = pack(vx[k], vy[k], vz[k], 1);
+  }
+}
+
+inline std::uint32_t slot_of(std::uint64_t key, std::uint32_t shift) {
+  return static_cast<std::uint32_t>((key * 0x9E3779B97F4A7C15ULL) >> shift);
+}
+
+std::uint32_t log2_ceil(std::size_t n) {
+  std::uint32_t b = 0;
+  while ((std::size_t{1} << b) < n) ++b;
+  return b;
+}
+
+}  // namespace
+
+VoxelGrid::VoxelGrid(const VoxelParams& params) : params_(params) {
+  if (!(params_.leaf_m > 0.0) || !std::isfinite(params_.leaf_m)) {
+    throw std::invalid_argument("VoxelGrid: leaf_m must be positive");
+  }
+  coarse_ = params_.coarse_from_m > 0.0;
+  if (coarse_ && !(params_.max_leaf_m >= params_.leaf_m)) {
+    throw std::invalid_argument("VoxelGrid: max_leaf_m must not be less than leaf_m");
+  }
+  // Leaf per range band: band b (1-based) uses leaf * b, capped; without coarsening, one band.
+  if (coarse_) {
+    bands_ = static_cast<std::uint32_t>(
+        std::clamp(std::ceil(params_.max_leaf_m / params_.leaf_m - 1e-9), 1.0, static_cast<double>(kMaxBands)));
+    inv_band_range_ = static_cast<float>(1.0 / params_.coarse_from_m);
+  }
+  for (std::uint32_t b = 1; b <= bands_; ++b) {
+    const double leaf = std::min(params_.leaf_m * b, coarse_ ? params_.max_leaf_m : params_.leaf_m);
+    inv_[b] = 1.0F / static_cast<float>(leaf);  // as pcl::VoxelGrid: the inverse leaf in float
+  }
+}
+
+std::uint64_t VoxelGrid::coarse_key(float x, float y, float z) const {
+  const float r = std::sqrt(x * x + y * y) * inv_band_range_;
+  const std::uint32_t band = r >= static_cast<float>(bands_) ? bands_ : std::max(1U, static_cast<std::uint32_t>(r));
+  const float s = inv_[band];
+  return pack(voxel_coord(x * s), voxel_coord(y * s), voxel_coord(z * s), band);
+}
+
+// The table holds voxel ids offset by this frame's base: a slot is taken when its id minus the base is below
+// the voxel count, so a new frame (a new base) empties it without touching it.
+__attribute__((noinline, cold)) void VoxelGrid::grow_table() {
+  const std::size_t size = std::max<std::size_t>(1024, table_.size() * 2);
+  table_.assign(size, 0U);
+  mask_ = static_cast<std::uint32_t>(size - 1);
+  shift_ = 64U - log2_ceil(size);
+  base_ = 1;  // table entries are 0: none is in [1, 1 + voxels)
+  for (std::uint32_t id = 0; id < voxels_; ++id) {
+    std::uint32_t h = slot_of(keys_[id], shift_);
+    while (table_[h] - base_ < voxels_) h = (h + 1) & mask_;
+    table_[h] = base_ + id;
+  }
+}
+
+inline std::uint32_t VoxelGrid::find_or_insert(std::uint64_t key) {
+  std::uint32_t h = slot_of(key, shift_);
+  for (;;) {
+    const std::uint32_t id = table_[h] - base_;
+    if (id >= voxels_) break;  // empty in this frame
+    if (keys_[id] == key) return id;
+    h = (h + 1) & mask_;
+  }
+  const std::uint32_t id = voxels_++;
+  keys_[id] = key;
+  sums_[id] = Sum{0.F, 0.F, 0.F, 0};
+  if (static_cast<std::size_t>(voxels_) * 2 > table_.size()) [[unlikely]] {
+    grow_table();  // re-inserts every key, this one included
+  } else {
+    table_[h] = base_ + id;
+  }
+  return id;
+}
+
+void VoxelGrid::begin(std::size_t max_points) {
+  // Ids of this frame start after the last frame's; when they would run out of 32 bits, the table is cleared.
+  const std::uint64_t next = static_cast<std::uint64_t>(base_) + voxels_ + max_points + 1;
+  voxels_ = 0;
+  if (sums_.size() < max_points) {
+    sums_.resize(max_points);
+    keys_.resize(max_points);
+  }
+  if (table_.empty()) grow_table();
+  if (next > 0xFFFFFFFFULL) {
+    std::fill(table_.begin(), table_.end(), 0U);
+    base_ = 1;
+  } else {
+    base_ = static_cast<std::uint32_t>(next - max_points);
+  }
+  for (auto& c : cache_) {
+    c.sum = simd::splat(0.F);
+    c.key = kNoKey;
+    c.n = 0;
+  }
+  queued_ = 0;
+}
+
+// One point into the voxel `key`: into its ring's cache entry while the ring stays in one voxel. When it
+// moves on, the finished run (key, sums, count) is queued; queued runs meet the table in batches.
+inline void VoxelGrid::add(std::uint64_t key, std::uint32_t ring, simd::f32x4 p) {
+  CacheEntry& c = cache_[ring & (kRingCache - 1)];
+  // Without branches on the data (whether a ring stays in its voxel is a coin flip for the predictor): the
+  // entry's run is written to the queue every time, and the queue moves on only when the run has finished.
+  const bool moved = c.key != key;
+  runs_[queued_] = Run{c.sum, c.key, c.n, 0};
+  queued_ += (moved && c.key != kNoKey) ? 1U : 0U;
+  const simd::f32x4 keep = moved ? simd::splat(0.F) : c.sum;
+  c.sum = keep + p;  // lanes x, y, z (the fourth is not used)
+  c.n = moved ? 1U : c.n + 1U;
+  c.key = key;
+  if (queued_ == kRunBatch) [[unlikely]]
+    drain_runs();
+}
+
+inline void VoxelGrid::queue_run(const CacheEntry& c) {
+  runs_[queued_++] = Run{c.sum, c.key, c.n, 0};
+  if (queued_ == kRunBatch) drain_runs();
+}
+
+// The queued runs into their voxels, in queue order (so the voxel ids, and the output order, depend only on
+// the input). Two passes, each fetching a few runs ahead: the table slots, then the voxels' sums. A run's
+// lookup would otherwise wait on memory while nothing else can go on.
+void VoxelGrid::drain_runs() {
+  constexpr std::uint32_t kAhead = 6;
+  for (std::uint32_t j = 0; j < queued_; ++j) {
+    if (j + kAhead < queued_) __builtin_prefetch(&table_[slot_of(runs_[j + kAhead].key, shift_)]);
+    Run& r = runs_[j];
+    r.id = find_or_insert(r.key);
+  }
+  for (std::uint32_t j = 0; j < queued_; ++j) {
+    if (j + kAhead < queued_) __builtin_prefetch(&sums_[runs_[j + kAhead].id], 1);
+    const Run& r = runs_[j];
+    Sum& a = sums_[r.id];
+    a.x += r.sum[0];
+    a.y += r.sum[1];
+    a.z += r.sum[2];
+    a.n += r.n;
+  }
+  queued_ = 0;
+}
+
+void VoxelGrid::finish(Cloud& out) {
+  for (const auto& c : cache_) {
+    if (c.key != kNoKey) queue_run(c);
+  }
+  drain_runs();
+  out.resize_xyz(voxels_);
+  float* ox = out.x.data();
+  float* oy = out.y.data();
+  float* oz = out.z.data();
+  for (std::uint32_t v = 0; v < voxels_; ++v) {
+    const Sum& a = sums_[v];
+    const auto cnt = static_cast<float>(a.n);
+    ox[v] = a.x / cnt;
+    oy[v] = a.y / cnt;
+    oz[v] = a.z / cnt;
+  }
+}
+
+// Points [0, n) of x, y, z (ring: one per point, or null) into their voxels, kBlock keys at a time.
+void VoxelGrid::add_points(const float* px, const float* py, const float* pz, const std::uint16_t* ring,
+                           std::size_t n) {
+  std::uint64_t keys[kBlock];
+  float tx[kBlock] = {}, ty[kBlock] = {}, tz[kBlock] = {};
+  for (std::size_t base = 0; base < n; base += kBlock) {
+    const std::size_t m = std::min(kBlock, n - base);
+    if (coarse_) {
+      for (std::size_t j = 0; j < m; ++j) keys[j] = coarse_key(px[base + j], py[base + j], pz[base + j]);
+    } else if (m == kBlock) {
+      block_keys(px + base, py + base, pz + base, inv_[1], keys);
+    } else {  // the tail, through a padded copy
+      std::copy_n(px + base, m, tx);
+      std::copy_n(py + base, m, ty);
+      std::copy_n(pz + base, m, tz);
+      block_keys(tx, ty, tz, inv_[1], keys);
+    }
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t i = base + j;
+      add(keys[j], ring != nullptr ? ring[i] : 0U, simd::f32x4{px[i], py[i], pz[i], 0.F});
+    }
+  }
+}
+
+void VoxelGrid::filter(const Cloud& in, Cloud& out) {
+  const std::size_t n = in.size();
+  begin(n);
+  add_points(in.x.data(), in.y.data(), in.z.data(), in.ring.size() == n ? in.ring.data() : nullptr, n);
+  finish(out);
+}
+
+}  // namespace fieldguard::perception

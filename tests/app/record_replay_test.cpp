@@ -1,0 +1,173 @@
+// Record-then-replay: the emulators feed a live `fieldguard record` (3D LiDAR UDP on loopback, the 2D LiDAR
+// over TCP, GNSS and AHRS on pseudo-terminals); `fieldguard replay --session` must decode the recording to
+// exactly the samples record decoded live, sensor by sensor.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/run_command.hpp"
+#include "fieldguard/io/pcap_reader.hpp"
+#include "io/pcap_builder.hpp"
+
+namespace fieldguard {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A child process whose first output line we read (a port or a device path); killed at the end.
+class Child {
+ public:
+  explicit Child(const std::vector<std::string>& argv) {
+    int out[2];
+    if (::pipe(out) != 0) return;
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(out[1], STDOUT_FILENO);
+      ::close(out[0]);
+      ::close(out[1]);
+      std::vector<char*> a;
+      for (const auto& s : argv) a.push_back(const_cast<char*>(s.c_str()));
+      a.push_back(nullptr);
+      ::execv(a[0], a.data());
+      ::_exit(127);
+    }
+    ::close(out[1]);
+    file_ = ::fdopen(out[0], "r");
+  }
+  std::string line() {
+    char buf[256] = {};
+    if (file_ == nullptr || std::fgets(buf, sizeof buf, file_) == nullptr) return {};
+    std::string s(buf);
+    s.erase(s.find_last_not_of("\r\n") + 1);
+    return s;
+  }
+  int wait() {
+    int status = 0;
+    if (pid_ > 0) ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  ~Child() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      ::waitpid(pid_, nullptr, 0);
+    }
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+ private:
+  pid_t pid_ = -1;
+  FILE* file_ = nullptr;
+};
+
+std::uint16_t free_udp_port() {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t len = sizeof a;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+std::map<std::string, std::vector<std::string>> by_sensor(const std::string& path) {
+  std::map<std::string, std::vector<std::string>> m;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto at = line.find("\"sensor\":\"");
+    if (at == std::string::npos) continue;
+    const auto end = line.find('"', at + 10);
+    m[line.substr(at + 10, end - at - 10)].push_back(line);
+  }
+  return m;
+}
+
+TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
+  testing::TempDir dir;
+  const std::string data = FIELDGUARD_TEST_DATA;
+  Child scip({FIELDGUARD_SCIP_EMULATOR, "--scene", "obstacle"});
+  const std::string scip_port = scip.line();
+  ASSERT_FALSE(scip_port.empty());
+  Child gnss({FIELDGUARD_SERIAL_EMULATOR, "--file", data + "/nmea/nmea-rtk.log", "--baud", "115200", "--hold-open", "30"});
+  const std::string gnss_dev = gnss.line();
+  Child ahrs({FIELDGUARD_SERIAL_EMULATOR, "--file", data + "/xsens/einride_1.bin", "--baud", "921600", "--hold-open", "30"});
+  const std::string ahrs_dev = ahrs.line();
+  ASSERT_FALSE(gnss_dev.empty());
+  ASSERT_FALSE(ahrs_dev.empty());
+
+  const std::uint16_t data_port = free_udp_port();
+  const std::uint16_t position_port = free_udp_port();
+  const std::string config = (dir.path() / "live.yaml").string();
+  std::ofstream(config) << "lidar: {model: auto, data_port: " << data_port << ", position_port: " << position_port << "}\n"
+                        << "scan2d: {enabled: true, host: 127.0.0.1, port: " << scip_port << "}\n"
+                        << "gnss: {enabled: true, device: " << gnss_dev << ", baud: 115200}\n"
+                        << "ahrs: {enabled: true, device: " << ahrs_dev << ", baud: 921600}\n";
+  const std::string session = (dir.path() / "session").string();
+  const std::string live = (dir.path() / "live.jsonl").string();
+  Child record({FIELDGUARD_BINARY, "record", "--config", config, "--out", session, "--duration", "3", "--samples-out", live});
+  std::this_thread::sleep_for(500ms);  // let it bind its ports
+
+  // The real HDL-32E capture, sent to the recorder at the sensor's packet rate.
+  const int tx = ::socket(AF_INET, SOCK_DGRAM, 0);
+  auto reader = io::PcapReader::open(data + "/hdl32e_monterey_600.pcap");
+  ASSERT_TRUE(reader.has_value());
+  std::size_t sent = 0;
+  while (auto d = reader->next()) {
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(d->dst_port == 2368 ? data_port : position_port);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    sent += ::sendto(tx, d->payload.data(), d->payload.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) > 0 ? 1U : 0U;
+    std::this_thread::sleep_for(550us);
+  }
+  ::close(tx);
+  ASSERT_EQ(sent, 600U);
+  ASSERT_EQ(record.wait(), 0);
+
+  const std::string replayed = (dir.path() / "replay.jsonl").string();
+  auto r = testing::run_fieldguard("replay --config '" + config + "' --session '" + session + "' --samples-out '" + replayed + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  const auto a = by_sensor(live);
+  const auto b = by_sensor(replayed);
+  for (const char* sensor : {"lidar", "lidar_position", "scan2d", "gnss", "ahrs"}) {
+    ASSERT_TRUE(a.count(sensor)) << "nothing decoded live from " << sensor;
+    EXPECT_FALSE(a.at(sensor).empty()) << sensor;
+    ASSERT_TRUE(b.count(sensor)) << "nothing replayed from " << sensor << "\n" << r.output;
+    EXPECT_EQ(a.at(sensor), b.at(sensor)) << sensor;
+  }
+  std::printf("live samples: lidar %zu, lidar_position %zu, scan2d %zu, gnss %zu, ahrs %zu\n", a.at("lidar").size(),
+              a.at("lidar_position").size(), a.at("scan2d").size(), a.at("gnss").size(), a.at("ahrs").size());
+  EXPECT_EQ(a.at("lidar_position").size(), 60U);
+  EXPECT_EQ(a.at("gnss").size(), 244U);  // every sentence of the log (122 GGA + 122 RMC)
+  EXPECT_EQ(a.at("ahrs").size(), 100U);  // every message of the einride stream
+  EXPECT_GT(a.at("scan2d").size(), 60U);  // 40 Hz for about 2.5 s
+
+  // The same recording given file by file.
+  const std::string one_by_one = (dir.path() / "files.jsonl").string();
+  auto f = testing::run_fieldguard("replay --config '" + config + "' --pcap '" + session + "/lidar.pcap' --scan2d-log '" +
+                                   session + "/scan2d.log' --gnss-log '" + session + "/gnss.log' --ahrs-log '" + session +
+                                   "/ahrs.log' --samples-out '" + one_by_one + "'");
+  ASSERT_EQ(f.exit_code, 0) << f.output;
+  EXPECT_EQ(by_sensor(one_by_one), b);
+}
+
+}  // namespace
+}  // namespace fieldguard

@@ -1,0 +1,115 @@
+#include "fieldguard/perception/cluster_filter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "perception/test_clouds.hpp"
+
+namespace fieldguard::perception {
+namespace {
+
+ClusterSummary summary(std::uint32_t points, float distance, std::array<float, 3> size, float height) {
+  ClusterSummary s;
+  s.points = points;
+  s.distance_m = distance;
+  s.min = {distance, 0.F, -0.9F};
+  s.max = {distance + size[0], size[1], -0.9F + size[2]};
+  s.height_above_ground_m = height;
+  return s;
+}
+
+TEST(ClusterFilter, PublishedCountAndVolumeBoundsAreInclusive) {
+  const FilterParams f = published_params().filters;
+  EXPECT_EQ(check_cluster(f, summary(10, 5.F, {0.5F, 0.5F, 0.5F}, 0.F)), Rejection::Kept);
+  EXPECT_EQ(check_cluster(f, summary(9, 5.F, {0.5F, 0.5F, 0.5F}, 0.F)), Rejection::TooFewPoints);
+  EXPECT_EQ(check_cluster(f, summary(240, 5.F, {0.5F, 0.5F, 0.5F}, 0.F)), Rejection::Kept);
+  EXPECT_EQ(check_cluster(f, summary(241, 5.F, {0.5F, 0.5F, 0.5F}, 0.F)), Rejection::TooManyPoints);
+  EXPECT_EQ(check_cluster(f, summary(50, 5.F, {0.5F, 0.25F, 0.5F}, 0.F)), Rejection::Kept);     // 0.0625 m^3
+  EXPECT_EQ(check_cluster(f, summary(50, 5.F, {0.2F, 0.2F, 1.0F}, 0.F)), Rejection::TooSmall);  // 0.04 m^3
+  EXPECT_EQ(check_cluster(f, summary(50, 5.F, {1.F, 1.F, 1.25F}, 0.F)), Rejection::TooLarge);
+  // Far and low: the published filters know neither.
+  EXPECT_EQ(check_cluster(f, summary(10, 40.F, {0.5F, 0.5F, 0.5F}, 0.1F)), Rejection::Kept);
+}
+
+TEST(ClusterFilter, ZeroMaximaAreNoLimits) {
+  FilterParams f;
+  f.max_points = 0;
+  f.max_volume_m3 = 0.0;
+  f.min_height_m = 0.0;
+  EXPECT_EQ(check_cluster(f, summary(100000, 5.F, {20.F, 10.F, 6.F}, 6.F)), Rejection::Kept);
+}
+
+// Height above the local ground: a 0.6 m object stays, a 0.3 m clod is terrain.
+TEST(ClusterFilter, HeightAboveGroundKeepsAnObjectAndDropsAClod) {
+  FilterParams f;
+  f.min_height_m = 0.5;
+  EXPECT_EQ(check_cluster(f, summary(30, 8.F, {0.4F, 0.4F, 0.6F}, 0.6F)), Rejection::Kept);
+  EXPECT_EQ(check_cluster(f, summary(30, 8.F, {0.4F, 0.4F, 0.3F}, 0.3F)), Rejection::TooLow);
+  f.min_height_m = 0.0;  // off
+  EXPECT_EQ(check_cluster(f, summary(30, 8.F, {0.4F, 0.4F, 0.3F}, 0.3F)), Rejection::Kept);
+}
+
+TEST(ClusterFilter, MinimumPointsFallsWithDistance) {
+  FilterParams f;
+  f.min_points = 10;
+  f.min_points_full_range_m = 12.0;
+  f.min_points_floor = 3;
+  EXPECT_EQ(min_points_at(f, 5.F), 10U);
+  EXPECT_EQ(min_points_at(f, 12.F), 10U);
+  EXPECT_EQ(min_points_at(f, 15.F), 7U);  // 10 * (12/15)^2 = 6.4 -> 7
+  EXPECT_EQ(min_points_at(f, 20.F), 4U);  // 3.6 -> 4
+  EXPECT_EQ(min_points_at(f, 30.F), 3U);  // 1.6 -> the floor
+  // A side-on pedestrian at 30 m leaves a handful of voxels: enough far away, not enough near.
+  EXPECT_EQ(check_cluster(f, summary(4, 30.F, {0.2F, 0.5F, 1.4F}, 1.6F)), Rejection::Kept);
+  EXPECT_EQ(check_cluster(f, summary(4, 8.F, {0.2F, 0.5F, 1.4F}, 1.6F)), Rejection::TooFewPoints);
+  f.min_points_full_range_m = 0.0;  // off: min_points everywhere
+  EXPECT_EQ(min_points_at(f, 30.F), 10U);
+  f.min_points_full_range_m = 12.0;
+  f.min_points_floor = 50;  // a floor above min_points does not raise it
+  EXPECT_EQ(min_points_at(f, 30.F), 10U);
+}
+
+TEST(ClusterFilter, Summary) {
+  Cloud c;
+  c.push_back(3.F, 4.F, -0.5F);
+  c.push_back(6.F, 8.F, 0.5F);
+  c.push_back(9.F, 9.F, 9.F);  // not in the cluster
+  const std::vector<float> heights{0.4F, 1.4F, 3.F};
+  const std::vector<std::uint32_t> members{0, 1};
+  const ClusterSummary s = summarize(c, heights, {}, members);
+  EXPECT_EQ(s.points, 2U);
+  EXPECT_FLOAT_EQ(s.distance_m, 5.F);  // horizontal, to the nearest point
+  EXPECT_FLOAT_EQ(s.height_above_ground_m, 1.4F);
+  EXPECT_EQ(s.min, (std::array<float, 3>{3.F, 4.F, -0.5F}));
+  EXPECT_EQ(s.max, (std::array<float, 3>{6.F, 8.F, 0.5F}));
+  EXPECT_FLOAT_EQ(s.volume_m3(), 12.F);
+}
+
+// Standing only on guessed ground (nothing measured near), a cluster's height is at most what it shows: one
+// flat ring far out does not become a metre-high obstacle because the ground was extrapolated a metre low.
+TEST(ClusterFilter, GuessedGroundLimitsTheHeightToTheClustersOwnExtent) {
+  Cloud c;
+  c.push_back(49.5F, -2.3F, -1.15F);
+  c.push_back(49.8F, -2.8F, -1.16F);
+  c.push_back(49.9F, -2.6F, -1.16F);
+  const std::vector<float> heights{1.32F, 1.31F, 1.31F};
+  const std::vector<std::uint32_t> members{0, 1, 2};
+  const std::vector<std::uint8_t> guessed{1, 1, 1}, measured{0, 1, 1};
+  ClusterSummary s = summarize(c, heights, guessed, members);
+  EXPECT_TRUE(s.ground_guessed);
+  limit_height_to_extent(s, s.min[2]);
+  EXPECT_NEAR(s.height_above_ground_m, 0.01F, 1e-5F);
+  // One point on measured ground: its height stands.
+  s = summarize(c, heights, measured, members);
+  EXPECT_FALSE(s.ground_guessed);
+  limit_height_to_extent(s, s.min[2]);
+  EXPECT_FLOAT_EQ(s.height_above_ground_m, 1.32F);
+  // A person's chest seen by one ring, with its feet (labelled ground) 0.7 m below: 0.7 m.
+  s = summarize(c, heights, guessed, members);
+  limit_height_to_extent(s, -1.86F);
+  EXPECT_NEAR(s.height_above_ground_m, 0.71F, 1e-5F);
+}
+
+}  // namespace
+}  // namespace fieldguard::perception

@@ -1,0 +1,69 @@
+#include "fieldguard/perception/crop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <vector>
+
+#include "perception/test_clouds.hpp"
+
+namespace fieldguard::perception {
+namespace {
+
+using testing::lidar_point;
+
+const Box3 kRoi{{-10.0, -10.0, -1.5}, {50.0, 10.0, 6.0}};
+const Box3 kBody{{-5.0, -1.5, -1.5}, {0.4, 1.5, 1.5}};
+
+TEST(CropBox, KeepsTheRoiFacesAndDropsTheBodyFaces) {
+  const std::vector<LidarPoint> in = {
+      lidar_point(50.0F, 0.0F, 0.0F, 1),     // on the ROI's far face: kept (closed box, as pcl::CropBox)
+      lidar_point(-10.0F, 9.0F, 0.0F, 2),    // on the ROI's back face, outside the body: kept
+      lidar_point(20.0F, 10.0F, 6.0F, 3),    // on an ROI edge: kept
+      lidar_point(50.01F, 0.0F, 0.0F, 4),    // just beyond: dropped
+      lidar_point(20.0F, -10.01F, 0.0F, 5),  // just beyond the side: dropped
+      lidar_point(0.4F, 0.0F, 0.0F, 6),      // on the body's front face: removed
+      lidar_point(-5.0F, 1.5F, 1.5F, 7),     // on a body corner: removed
+      lidar_point(0.41F, 0.0F, 0.0F, 8),     // just in front of the body: kept
+      lidar_point(-1.0F, 1.51F, 0.0F, 9),    // just beside the body: kept
+      lidar_point(-1.0F, 0.0F, 1.51F, 10),   // just above the body: kept
+  };
+  Cloud out;
+  crop_box(in, kRoi, kBody, out);
+  ASSERT_EQ(out.size(), 6U);
+  const std::vector<std::uint16_t> rings(out.ring.begin(), out.ring.end());
+  EXPECT_EQ(rings, (std::vector<std::uint16_t>{1, 2, 3, 8, 9, 10}));  // input order, rings carried
+  EXPECT_FLOAT_EQ(out.x[3], 0.41F);
+  EXPECT_FLOAT_EQ(out.y[4], 1.51F);
+  EXPECT_FLOAT_EQ(out.z[5], 1.51F);
+}
+
+TEST(CropBox, DropsNanAndInfinity) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<LidarPoint> in = {lidar_point(nan, 0, 0), lidar_point(5, nan, 0),  lidar_point(5, 0, nan),
+                                      lidar_point(inf, 0, 0), lidar_point(5, -inf, 0), lidar_point(5, 0, inf),
+                                      lidar_point(5, 1, 0.5F)};
+  Cloud out;
+  crop_box(in, kRoi, kBody, out);
+  ASSERT_EQ(out.size(), 1U);
+  EXPECT_FLOAT_EQ(out.x[0], 5.0F);
+  // An infinite ROI lets only finite points through too.
+  const Box3 everything{{-inf, -inf, -inf}, {inf, inf, inf}};
+  crop_box(in, everything, kBody, out);
+  EXPECT_EQ(out.size(), 1U);
+}
+
+TEST(CropBox, EmptyInputAndEverythingInTheBody) {
+  Cloud out;
+  out.push_back(1, 2, 3, 4);  // stale content is replaced
+  crop_box({}, kRoi, kBody, out);
+  EXPECT_TRUE(out.empty());
+  const std::vector<LidarPoint> body = {lidar_point(0, 0, 0), lidar_point(-4, 1, -1), lidar_point(0.3F, -1.4F, 1.4F)};
+  crop_box(body, kRoi, kBody, out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_TRUE(out.ring.empty());
+}
+
+}  // namespace
+}  // namespace fieldguard::perception

@@ -1,0 +1,63 @@
+#pragma once
+// Hand-made clouds for the perception tests.
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/perception/cloud.hpp"
+
+namespace fieldguard::perception::testing {
+
+inline LidarPoint lidar_point(float x, float y, float z, std::uint16_t ring = 0) {
+  LidarPoint p;
+  p.x = x;
+  p.y = y;
+  p.z = z;
+  p.ring = ring;
+  p.range_m = std::sqrt(x * x + y * y + z * z);
+  return p;
+}
+
+inline std::vector<LidarPoint> to_lidar(const Cloud& c) {
+  std::vector<LidarPoint> out;
+  for (std::size_t i = 0; i < c.size(); ++i) out.push_back(lidar_point(c.x[i], c.y[i], c.z[i]));
+  return out;
+}
+
+// Deterministic uniform numbers (SplitMix64), for random clouds that are the same on every platform.
+struct TestRng {
+  std::uint64_t s;
+  std::uint64_t next() {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31U);
+  }
+  float uniform(float lo, float hi) {
+    return lo + (hi - lo) * static_cast<float>(static_cast<double>(next() >> 40U) * 0x1.0p-24);
+  }
+};
+
+// A solid block of points on a regular lattice: min corner, counts per axis, spacing.
+inline void add_block(Cloud& c, std::array<float, 3> min, std::array<int, 3> counts, float step) {
+  for (int i = 0; i < counts[0]; ++i) {
+    for (int j = 0; j < counts[1]; ++j) {
+      for (int k = 0; k < counts[2]; ++k) {
+        c.push_back(min[0] + step * static_cast<float>(i), min[1] + step * static_cast<float>(j),
+                    min[2] + step * static_cast<float>(k));
+      }
+    }
+  }
+}
+
+// Ground z = a x + b y + c sampled on a grid over [x0, x1] x [y0, y1].
+inline void add_plane(Cloud& c, float a, float b, float z0, float x0, float x1, float y0, float y1, float step) {
+  for (float x = x0; x <= x1; x += step) {
+    for (float y = y0; y <= y1; y += step) c.push_back(x, y, a * x + b * y + z0);
+  }
+}
+
+}  // namespace fieldguard::perception::testing

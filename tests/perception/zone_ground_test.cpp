@@ -1,0 +1,179 @@
+#include "fieldguard/perception/zone_ground.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "../../benchmarks/synthetic_scene.hpp"
+#include "fieldguard/perception/crop.hpp"
+#include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/perception/voxel_grid.hpp"
+#include "perception/test_clouds.hpp"
+
+namespace fieldguard::perception {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A scan of the scene after ROI, body and voxel grid, as the ground stage sees it.
+Cloud prepared(const sim::Scene& scene, double hz = 10.0) {
+  sim::ScanSpec spec;
+  spec.rotation_hz = hz;
+  spec.max_range_m = 70.0;
+  const auto pts = sim::scan(scene, spec);
+  const PipelineParams p;
+  Cloud cropped, out;
+  crop_box(pts, p.roi, p.body, cropped);
+  VoxelGrid grid(p.voxel);
+  grid.filter(cropped, out);
+  return out;
+}
+
+TEST(ZoneGround, FindsATiltedPlaneWithinOneDegree) {
+  sim::Scene scene;
+  scene.terrain.slope_x = std::tan(5.0 * kPi / 180.0);
+  scene.terrain.slope_y = std::tan(-3.0 * kPi / 180.0);
+  const Cloud c = prepared(scene);
+  ZoneGround zones(ZoneParams{});
+  GroundLabels labels;
+  zones.segment(c, labels);
+  const double true_angle_tol = 1.0;
+  int fitted = 0;
+  for (float x = 3.F; x < 30.F; x += 1.5F) {
+    for (float y = -9.F; y <= 9.F; y += 1.5F) {
+      // The ground under (x, y) in the sensor frame (sensor 0.95 m above the ground at the origin).
+      const auto truth = static_cast<float>(scene.terrain.z(x, y) - scene.sensor_height_m);
+      EXPECT_NEAR(zones.ground_z(x, y), truth, 0.06F) << x << ", " << y;
+      if (!zones.fitted_at(x, y)) continue;
+      ++fitted;
+      const GroundPlane p = zones.plane_at(x, y);
+      const double c_ang =
+          (scene.terrain.slope_x * static_cast<double>(p.a) + scene.terrain.slope_y * static_cast<double>(p.b) + 1.0) /
+          (std::hypot(scene.terrain.slope_x, scene.terrain.slope_y, 1.0) *
+           std::hypot(static_cast<double>(p.a), static_cast<double>(p.b), 1.0));
+      EXPECT_LT(std::acos(std::min(1.0, c_ang)) * 180.0 / kPi, true_angle_tol) << x << ", " << y;
+    }
+  }
+  EXPECT_GT(fitted, 100);
+  std::size_t ground = 0;
+  for (const auto g : labels.ground) ground += g;
+  EXPECT_EQ(ground, c.size());  // a bare plane is all ground
+}
+
+// The tractor rolled 8 degrees and pitched 4: the ground is tilted in the sensor frame, and still ground.
+TEST(ZoneGround, HoldsWhenTheVehicleRollsAndPitches) {
+  sim::Scene scene;
+  scene.roll_deg = 8.0;
+  scene.pitch_deg = -4.0;
+  scene.terrain.furrow_m = 0.04;
+  const Cloud c = prepared(scene);
+  ZoneGround zones(ZoneParams{});
+  GroundLabels labels;
+  zones.segment(c, labels);
+  std::size_t ground = 0;
+  for (const auto g : labels.ground) ground += g;
+  EXPECT_GT(static_cast<double>(ground), 0.995 * static_cast<double>(c.size()));
+  Pipeline pipe(PipelineParams{});
+  const auto pts = sim::scan(scene, sim::ScanSpec{});
+  EXPECT_TRUE(pipe.process(pts).obstacles.empty());
+}
+
+// A field ridge 35 cm high on a 6-degree slope: the slope is ground, the ridge is not (it stands 35 cm above
+// the local ground, so the height filter calls it terrain), and a person behind it is not swallowed.
+TEST(ZoneGround, RidgeOnASlopeIsNotGroundAndNotAnObstacle) {
+  sim::Scene scene;
+  scene.terrain.slope_x = std::tan(6.0 * kPi / 180.0);
+  scene.terrain.ridge_x_m = 9.0;
+  scene.terrain.ridge_width_m = 1.2;
+  scene.terrain.ridge_height_m = 0.35;
+  const Cloud c = prepared(scene);
+  ZoneGround zones(ZoneParams{});
+  GroundLabels labels;
+  zones.segment(c, labels);
+  int crest = 0, crest_ground = 0, slope = 0, slope_ground = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const double base = scene.terrain.slope_x * static_cast<double>(c.x[i]) - scene.sensor_height_m;
+    const double above_base = static_cast<double>(c.z[i]) - base;
+    if (std::fabs(c.x[i] - 9.0F) < 0.2F && std::fabs(c.y[i]) < 8.F) {
+      ++crest;
+      crest_ground += labels.ground[i];
+      EXPECT_NEAR(labels.height_m[i], above_base, 0.1) << c.x[i] << ", " << c.y[i];
+    } else if (std::fabs(c.x[i] - 9.0F) > 2.0F) {
+      ++slope;
+      slope_ground += labels.ground[i];
+    }
+  }
+  ASSERT_GT(crest, 10);
+  EXPECT_EQ(crest_ground, 0);
+  EXPECT_GT(static_cast<double>(slope_ground), 0.995 * slope);
+
+  Pipeline pipe(PipelineParams{});
+  const auto pts = sim::scan(scene, sim::ScanSpec{});
+  const auto bare = pipe.process(pts);
+  EXPECT_TRUE(bare.obstacles.empty()) << bare.obstacles.size() << " obstacles, first at "
+                                      << (bare.obstacles.empty() ? 0.F : bare.obstacles[0].distance_m) << " m";
+
+  // People on the slope behind the ridge, near and far: found, standing on the local ground. (Up a 6-degree
+  // slope the top rings pass over their heads: the highest return is 1.47 m up the near one, 1.3 m up the far.)
+  scene.cylinders.push_back(sim::person(15.0, 2.0));
+  scene.cylinders.push_back(sim::person(30.0, -1.0));
+  const auto with_people = pipe.process(sim::scan(scene, sim::ScanSpec{}));
+  ASSERT_EQ(with_people.obstacles.size(), 2U);
+  EXPECT_NEAR(with_people.obstacles[0].distance_m, 14.75F, 0.3F);
+  EXPECT_NEAR(with_people.obstacles[1].distance_m, 29.75F, 0.3F);
+  EXPECT_NEAR(with_people.obstacles[0].height_above_ground_m, 1.47F, 0.2F);
+  EXPECT_NEAR(with_people.obstacles[1].height_above_ground_m, 1.3F, 0.2F);
+  for (const float x : {15.F, 30.F}) {
+    EXPECT_NEAR(pipe.ground_z(x, 0.F), static_cast<float>(scene.terrain.z(x, 0.0) - scene.sensor_height_m), 0.15F);
+  }
+}
+
+// A person standing where no ground is seen (the far zone of a 32-beam sensor: no ring reaches the flat
+// ground between 21 and 40 m) takes the ground of the bins around, not a plane through their legs.
+TEST(ZoneGround, FarPersonWithNoGroundAroundIsNotGround) {
+  sim::Scene scene;
+  scene.cylinders.push_back(sim::person(30.0, 0.5));
+  const Cloud c = prepared(scene);
+  ZoneGround zones(ZoneParams{});
+  GroundLabels labels;
+  zones.segment(c, labels);
+  int person = 0, person_ground = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (std::hypot(c.x[i] - 30.F, c.y[i] - 0.5F) < 0.4F && c.z[i] > -0.7F) {
+      ++person;
+      person_ground += labels.ground[i];
+    }
+  }
+  EXPECT_GE(person, 3);
+  EXPECT_EQ(person_ground, 0);
+  EXPECT_NEAR(zones.ground_z(30.F, 0.5F), -0.95F, 0.1F);
+}
+
+TEST(ZoneGround, EmptyInputAndTheSurfaceBeforeAnyFrame) {
+  ZoneParams p;
+  p.sensor_height_m = 1.2;
+  ZoneGround zones(p);
+  EXPECT_FLOAT_EQ(zones.ground_z(10.F, 3.F), -1.2F);
+  GroundLabels labels;
+  zones.segment(Cloud{}, labels);
+  EXPECT_TRUE(labels.ground.empty());
+  EXPECT_FLOAT_EQ(zones.ground_z(100.F, -70.F), -1.2F);  // beyond the last zone: the last ring's bin
+}
+
+TEST(ZoneGround, RefusesALayoutThatIsNone) {
+  ZoneParams p;
+  p.edges_m = {2.0, 1.0};
+  p.rings = {1};
+  p.sectors = {8};
+  EXPECT_THROW(ZoneGround{p}, std::invalid_argument);
+  p.edges_m = {1.0, 2.0, 3.0};
+  EXPECT_THROW(ZoneGround{p}, std::invalid_argument);  // two zones, one ring count
+  p.rings = {1, 0};
+  p.sectors = {8, 8};
+  EXPECT_THROW(ZoneGround{p}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fieldguard::perception
