@@ -255,14 +255,7 @@ int cmd_replay(const std::vector<std::string>& argv) {
   if (detect) pipeline.emplace(cfg.perception);
   std::uint64_t obstacles_total = 0;
 
-  velodyne::StreamOptions so;
-  so.model = cfg.lidar.model;
-  if (cfg.lidar.has_calibration) so.calibration = cfg.lidar.calibration;
-  so.timestamp_reference = cfg.lidar.timestamp_reference;
-  so.min_range_m = cfg.lidar.min_range_m;
-  so.max_range_m = cfg.lidar.max_range_m;
-  so.rotation_cut_deg = cfg.lidar.rotation_cut_deg;
-  velodyne::Stream stream(so);
+  velodyne::Stream stream(velodyne_stream_options(cfg.lidar));
 
   PositionCounters pos;
   PortCounters ports;

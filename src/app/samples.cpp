@@ -36,17 +36,6 @@ std::string num(double v) {
 }
 std::string opt(const std::optional<double>& v) { return v ? num(*v) : "null"; }
 
-velodyne::StreamOptions stream_options(const LidarConfig& c) {
-  velodyne::StreamOptions so;
-  so.model = c.model;
-  if (c.has_calibration) so.calibration = c.calibration;
-  so.timestamp_reference = c.timestamp_reference;
-  so.min_range_m = c.min_range_m;
-  so.max_range_m = c.max_range_m;
-  so.rotation_cut_deg = c.rotation_cut_deg;
-  return so;
-}
-
 scip::ClientConfig scip_config(const Scan2dConfig& c) {
   scip::ClientConfig cc;
   cc.scan.first_step = static_cast<std::uint16_t>(c.start_step);
@@ -57,8 +46,19 @@ scip::ClientConfig scip_config(const Scan2dConfig& c) {
 
 }  // namespace
 
+velodyne::StreamOptions velodyne_stream_options(const LidarConfig& c) {
+  velodyne::StreamOptions so;
+  so.model = c.model;
+  if (c.has_calibration) so.calibration = c.calibration;
+  so.timestamp_reference = c.timestamp_reference;
+  so.min_range_m = c.min_range_m;
+  so.max_range_m = c.max_range_m;
+  so.rotation_cut_deg = c.rotation_cut_deg;
+  return so;
+}
+
 struct SampleDecoder::Impl {
-  Impl(const Config& c, std::ostream* o) : config(c), out(o), stream(stream_options(c.lidar)), session(scip_config(c.scan2d)) {}
+  Impl(const Config& c, std::ostream* o) : config(c), out(o), stream(velodyne_stream_options(c.lidar)), session(scip_config(c.scan2d)) {}
 
   Config config;
   std::ostream* out;

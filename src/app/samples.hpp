@@ -10,9 +10,13 @@
 
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/core/bytes.hpp"
+#include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/udp_frame.hpp"
 
 namespace fieldguard::app {
+
+// The Velodyne stream as the configuration describes it (replay and the sample decoder build the same one).
+[[nodiscard]] velodyne::StreamOptions velodyne_stream_options(const LidarConfig& lidar);
 
 struct SampleCounts {
   std::uint64_t lidar_frames = 0;

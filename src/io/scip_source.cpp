@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include <chrono>
+#include "io/clock.hpp"
 
 #include "fieldguard/drivers/scip.hpp"
 #include "fieldguard/drivers/scip_session.hpp"
@@ -35,10 +35,7 @@ struct ScipSource::Impl {
     link.send(bytes);
   }
 
-  static Stamp now() {
-    return Stamp{std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-                     .count()};
-  }
+  static Stamp now() { return Stamp{detail::now_ns()}; }
 
   void connected() { send(session.connect()); }
 

@@ -6,7 +6,12 @@
 #include <boost/asio/steady_timer.hpp>
 #include <chrono>
 
+#include "io/clock.hpp"
+
 namespace fieldguard::io {
+
+using detail::now_ns;
+using detail::seconds;
 
 std::string_view to_string(SerialState s) {
   switch (s) {
@@ -16,19 +21,6 @@ std::string_view to_string(SerialState s) {
   }
   return "unknown";
 }
-
-namespace {
-
-std::chrono::steady_clock::duration seconds(double s) {
-  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
-}
-
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 // Shared with the pending asynchronous operations, so a handler that runs after stop() finds it alive.
 struct SerialReader::Impl : std::enable_shared_from_this<Impl> {

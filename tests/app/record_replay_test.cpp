@@ -5,9 +5,7 @@
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
-#include <signal.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -20,59 +18,14 @@
 #include "app/run_command.hpp"
 #include "fieldguard/io/pcap_reader.hpp"
 #include "io/pcap_builder.hpp"
+#include "support/child_process.hpp"
 
 namespace fieldguard {
 namespace {
 
 using namespace std::chrono_literals;
 
-// A child process whose first output line we read (a port or a device path); killed at the end.
-class Child {
- public:
-  explicit Child(const std::vector<std::string>& argv) {
-    int out[2];
-    if (::pipe(out) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(out[1], STDOUT_FILENO);
-      ::close(out[0]);
-      ::close(out[1]);
-      std::vector<char*> a;
-      for (const auto& s : argv) a.push_back(const_cast<char*>(s.c_str()));
-      a.push_back(nullptr);
-      ::execv(a[0], a.data());
-      ::_exit(127);
-    }
-    ::close(out[1]);
-    file_ = ::fdopen(out[0], "r");
-  }
-  std::string line() {
-    char buf[256] = {};
-    if (file_ == nullptr || std::fgets(buf, sizeof buf, file_) == nullptr) return {};
-    std::string s(buf);
-    s.erase(s.find_last_not_of("\r\n") + 1);
-    return s;
-  }
-  int wait() {
-    int status = 0;
-    if (pid_ > 0) ::waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  ~Child() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      ::waitpid(pid_, nullptr, 0);
-    }
-    if (file_ != nullptr) std::fclose(file_);
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
- private:
-  pid_t pid_ = -1;
-  FILE* file_ = nullptr;
-};
+using Child = testing::ChildProcess;
 
 std::uint16_t free_udp_port() {
   const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);

@@ -5,56 +5,32 @@
 
 #include <gtest/gtest.h>
 
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <boost/asio/io_context.hpp>
 #include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "support/child_process.hpp"
+
 namespace fieldguard::io {
 namespace {
 
 using namespace std::chrono_literals;
 
-// Runs the emulator as a process; its first line of output is its port. Killed when the test ends.
+// The emulator as a process; its first line of output is its port. Ended with the test.
 class Emulator {
  public:
-  explicit Emulator(const std::vector<std::string>& args) {
-    int out[2];
-    if (::pipe(out) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(out[1], STDOUT_FILENO);
-      ::close(out[0]);
-      ::close(out[1]);
-      std::vector<char*> argv{const_cast<char*>(FIELDGUARD_SCIP_EMULATOR)};
-      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-      argv.push_back(nullptr);
-      ::execv(FIELDGUARD_SCIP_EMULATOR, argv.data());
-      ::_exit(127);
-    }
-    ::close(out[1]);
-    FILE* f = ::fdopen(out[0], "r");
-    char line[64] = {};
-    if (f != nullptr && std::fgets(line, sizeof line, f) != nullptr) port_ = static_cast<std::uint16_t>(std::atoi(line));
-    if (f != nullptr) std::fclose(f);
+  explicit Emulator(std::vector<std::string> args) : child_([&] {
+    args.insert(args.begin(), FIELDGUARD_SCIP_EMULATOR);
+    return args;
+  }()) {
+    port_ = static_cast<std::uint16_t>(std::atoi(child_.line().c_str()));
   }
-  ~Emulator() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  Emulator(const Emulator&) = delete;
-  Emulator& operator=(const Emulator&) = delete;
   [[nodiscard]] std::uint16_t port() const { return port_; }
 
  private:
-  pid_t pid_ = -1;
+  testing::ChildProcess child_;
   std::uint16_t port_ = 0;
 };
 
