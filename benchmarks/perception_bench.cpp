@@ -34,8 +34,8 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
-#include <stdexcept>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -186,7 +186,8 @@ std::vector<LidarPoint> load_pcd(const std::string& path) {
   const auto data = s.find("DATA binary\n");
   const auto count_at = s.find("\nPOINTS ");
   if (!in.good() && s.empty()) throw std::runtime_error("cannot read " + path);
-  if (data == std::string::npos || count_at == std::string::npos || s.find("FIELDS x y z intensity ring time") == std::string::npos) {
+  if (data == std::string::npos || count_at == std::string::npos ||
+      s.find("FIELDS x y z intensity ring time") == std::string::npos) {
     throw std::runtime_error(path + ": not a fieldguard binary PCD (FIELDS x y z intensity ring time)");
   }
   const std::size_t count = std::stoul(s.substr(count_at + 8));

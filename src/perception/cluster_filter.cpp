@@ -64,7 +64,7 @@ std::uint32_t min_points_at(const FilterParams& f, float distance_m) {
 Rejection check_cluster(const FilterParams& f, const ClusterSummary& s) {
   if (s.points < min_points_at(f, s.distance_m)) return Rejection::TooFewPoints;
   if (f.max_points > 0 && s.points > static_cast<std::uint32_t>(f.max_points)) return Rejection::TooManyPoints;
-  const double v = s.volume_m3();
+  const double v = static_cast<double>(s.volume_m3());
   if (v < f.min_volume_m3) return Rejection::TooSmall;
   if (f.max_volume_m3 > 0.0 && v > f.max_volume_m3) return Rejection::TooLarge;
   if (f.min_height_m > 0.0 && static_cast<double>(s.height_above_ground_m) < f.min_height_m) return Rejection::TooLow;

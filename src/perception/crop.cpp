@@ -42,7 +42,7 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
   for (std::size_t i = 0; i < n; ++i) {
     const LidarPoint& p = in[i];
     const simd::f32x4 v = simd::load(&p.x);  // x, y, z, intensity
-    bool kept = keep.contains(v) & !drop.contains(v);
+    bool kept = keep.contains(v) && !drop.contains(v);
     if constexpr (check_finite) kept = kept && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
     x[k] = p.x;
     y[k] = p.y;

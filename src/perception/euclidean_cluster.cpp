@@ -79,7 +79,16 @@ void EuclideanClusterer::finish_cluster(Clusters& out) {
   out.indices.insert(out.indices.end(), queue_.begin(), queue_.end());
   std::uint32_t* b = out.indices.data() + first;
   std::uint32_t* e = out.indices.data() + out.indices.size();
-  if (e - b <= 16) {  // most clusters are a few points: insertion sort
+  const std::size_t count = static_cast<std::size_t>(e - b);
+  if (count > 64 && count * 8 > done_.size()) {
+    // A large share of the cloud (a wall, a building): in order by one pass over a bitmap of the cloud.
+    mark_.assign(done_.size(), 0U);
+    for (const std::uint32_t* it = b; it < e; ++it) mark_[*it] = 1U;
+    std::uint32_t* w = b;
+    for (std::size_t i = 0; i < mark_.size(); ++i) {
+      if (mark_[i] != 0U) *w++ = static_cast<std::uint32_t>(i);
+    }
+  } else if (e - b <= 16) {  // most clusters are a few points: insertion sort
     for (std::uint32_t* it = b + 1; it < e; ++it) {
       const std::uint32_t v = *it;
       std::uint32_t* j = it;
@@ -127,9 +136,7 @@ void EuclideanClusterer::extract_kdtree(const Cloud& in, Clusters& out) {
 }
 
 // Columns: the x-y plane in squares of the smallest radius (larger if that would make more than
-// kCellsPerPoint per point). A search scans the columns within its radius, skipping those a cluster has
-// already taken entirely. (Sorting each column by height and searching only the height slab costs more
-// than it saves on voxelised clouds: a column holds a few dozen points.)
+// kCellsPerPoint per point). A search scans the free points of the columns within its radius.
 void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   const std::size_t n = in.size();
   float lo[2] = {in.x[0], in.y[0]};
@@ -180,35 +187,44 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     grid_points_[p] = GridPoint{in.x[i], in.y[i], in.z[i], static_cast<std::uint32_t>(i)};
   }
   const auto col_begin = [this](std::size_t c) { return c == 0 ? 0U : col_start_[c - 1]; };
-  // Points of each column not yet in a cluster: a search skips a column once clusters have taken all of it
-  // (in a dense object, most of them), before any binary search.
-  col_left_.resize(cols);
-  for (std::size_t c = 0; c < cols; ++c) col_left_[c] = col_start_[c] - col_begin(c);
-  grid_col_.resize(n);
+  // Each column keeps the points not yet in a cluster behind a moving boundary: a point that joins a cluster
+  // is swapped in front of it. A search then scans only points still free: an object that one cluster has
+  // swallowed costs no more searching, however dense (a shed's wall). (Sorting the columns by height to search
+  // only the slab within the radius measured slower: a column of a voxelised cloud holds a few dozen points.)
+  col_next_.resize(cols);
+  for (std::size_t c = 0; c < cols; ++c) col_next_[c] = col_begin(c);
   if (adaptive_) sorted_r2_.resize(n);
   for (std::size_t p = 0; p < n; ++p) {
     const GridPoint& g = grid_points_[p];
-    grid_col_[p] = cell_of_[g.index];
     pos_of_[g.index] = static_cast<std::uint32_t>(p);
     if (adaptive_) sorted_r2_[p] = r2_[g.index];
   }
 
-  const GridPoint* gp = grid_points_.data();
-  const float* r2 = adaptive_ ? sorted_r2_.data() : nullptr;
+  GridPoint* gp = grid_points_.data();
+  float* r2 = adaptive_ ? sorted_r2_.data() : nullptr;
+  // Takes the free point at position j of column c into the cluster: to the members, and behind the boundary.
+  const auto take = [&](std::uint32_t j, std::size_t c) {
+    const std::uint32_t t = col_next_[c]++;
+    const GridPoint g = gp[j];
+    members_.push_back(Member{g.x, g.y, g.z, g.index, adaptive_ ? r2[j] : base_r2_});
+    done_[g.index] = 1U;
+    if (t != j) {
+      gp[j] = gp[t];
+      gp[t] = g;
+      pos_of_[gp[j].index] = j;
+      pos_of_[g.index] = t;
+      if (adaptive_) std::swap(r2[j], r2[t]);
+    }
+  };
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t seed = pos_of_[i];
-    if (done_[seed] != 0U) continue;
-    queue_.clear();
-    queue_.push_back(seed);
-    done_[seed] = 1U;
-    --col_left_[grid_col_[seed]];
-    for (std::size_t qi = 0; qi < queue_.size(); ++qi) {
-      const std::uint32_t pos = queue_[qi];
-      const GridPoint p = gp[pos];
+    if (done_[i] != 0U) continue;
+    members_.clear();
+    take(pos_of_[i], cell_of_[i]);
+    for (std::size_t qi = 0; qi < members_.size(); ++qi) {
+      const Member p = members_[qi];
       std::size_t k = 1;
-      float own = base_r2_, q2 = base_r2_;
+      float q2 = base_r2_;
       if (adaptive_) {
-        own = r2[pos];
         const float q = query_[p.index];
         q2 = q * q;
         k = static_cast<std::size_t>(q / e) + 1;  // at least ceil(q / e); a column more is skipped below
@@ -223,27 +239,25 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
         const float gx = std::max(0.F, std::max(fx - px, px - (fx + e)));
         for (std::size_t y = y0; y <= y1; ++y) {
           const std::size_t c = x * ny + y;
-          if (col_left_[c] == 0U) continue;
+          const std::uint32_t ce = col_start_[c];
+          if (col_next_[c] == ce) continue;  // nothing free here
           if (k > 1) {
             const float fy = static_cast<float>(y) * e;
             const float gy = std::max(0.F, std::max(fy - py, py - (fy + e)));
             if (!(gx * gx + gy * gy < q2)) continue;
           }
-          const std::uint32_t cb = col_begin(c), ce = col_start_[c];
-          for (std::uint32_t j = cb; j < ce; ++j) {
-            if (done_[j] != 0U) continue;
+          for (std::uint32_t j = col_next_[c]; j < ce; ++j) {
             const float dx = gp[j].x - p.x, dy = gp[j].y - p.y, dz = gp[j].z - p.z;
             const float d2 = dx * dx + dy * dy + dz * dz;
             if (!(d2 < q2)) continue;
-            if (adaptive_ && !(d2 < std::max(own, r2[j]))) continue;
-            done_[j] = 1U;
-            --col_left_[c];
-            queue_.push_back(j);
+            if (adaptive_ && !(d2 < std::max(p.r2, r2[j]))) continue;
+            take(j, c);  // the point swapped into j was scanned already: go on after it
           }
         }
       }
     }
-    for (auto& v : queue_) v = gp[v].index;
+    queue_.clear();
+    for (const Member& mb : members_) queue_.push_back(mb.index);
     finish_cluster(out);
   }
 }

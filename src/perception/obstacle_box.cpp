@@ -1,7 +1,10 @@
 #include "fieldguard/perception/obstacle_box.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numbers>
 
@@ -20,12 +23,82 @@ double cross(const P2& o, const P2& a, const P2& b) {
 
 std::string_view to_string(SizeClass c) { return c == SizeClass::Small ? "small" : "large"; }
 
-void convex_hull(std::span<const P2> all, std::vector<P2>& hull, std::vector<P2>& scratch) {
+// A float's bits as an unsigned integer in the same order (negatives flipped): (x, y) then sorts as one
+// 64-bit integer, and the mapping is one to one, so sorting the integers sorts the points exactly.
+std::uint64_t ordered_bits(float v) {
+  std::uint32_t u = 0;
+  std::memcpy(&u, &v, sizeof u);
+  return (u & 0x80000000U) != 0U ? ~u : (u | 0x80000000U);
+}
+float from_ordered_bits(std::uint64_t o) {
+  auto u = static_cast<std::uint32_t>(o);
+  u = (u & 0x80000000U) != 0U ? (u & 0x7FFFFFFFU) : ~u;
+  float v = 0.F;
+  std::memcpy(&v, &u, sizeof v);
+  return v;
+}
+
+// Sorts points by (x, y): std::sort when few, else an LSD radix sort of their 64-bit keys (six 11-bit
+// passes: linear in the count, where a comparison sort of a wall's thousands of points is not).
+void sort_points(std::vector<P2>& pts, HullScratch& s) {
+  const std::size_t n = pts.size();
+  if (n <= 256) {
+    std::sort(pts.begin(), pts.end());
+    return;
+  }
+  s.keys.resize(n);
+  s.keys_tmp.resize(n);
+  for (std::size_t i = 0; i < n; ++i) s.keys[i] = (ordered_bits(pts[i][0]) << 32U) | ordered_bits(pts[i][1]);
+  constexpr unsigned kBits = 11;  // six passes over 2048 counters
+  constexpr std::uint64_t kMask = (std::uint64_t{1} << kBits) - 1;
+  std::vector<std::uint32_t>& count = s.counts;
+  count.resize(std::size_t{1} << kBits);
+  for (unsigned shift = 0; shift < 64; shift += kBits) {
+    std::fill(count.begin(), count.end(), 0U);
+    for (const std::uint64_t k : s.keys) ++count[(k >> shift) & kMask];
+    std::uint32_t sum = 0;
+    for (auto& c : count) {
+      const std::uint32_t v = c;
+      c = sum;
+      sum += v;
+    }
+    for (const std::uint64_t k : s.keys) s.keys_tmp[count[(k >> shift) & kMask]++] = k;
+    s.keys.swap(s.keys_tmp);
+  }
+  for (std::size_t i = 0; i < n; ++i) pts[i] = P2{from_ordered_bits(s.keys[i] >> 32U), from_ordered_bits(s.keys[i])};
+}
+
+void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
   hull.clear();
-  scratch.assign(all.begin(), all.end());
+  std::vector<P2>& scratch = hs.points;
+  if (all.size() > 64) {
+    // Akl-Toussaint: the points extreme along x, x + y, y, y - x (both ways) span an octagon inside the hull;
+    // points strictly inside it cannot be hull vertices. A wall of thousands of points keeps a few dozen.
+    std::array<std::size_t, 8> ext{};
+    std::array<float, 8> best{};
+    best.fill(-std::numeric_limits<float>::max());
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const float x = all[i][0], y = all[i][1];
+      const float key[8] = {-x, -x - y, -y, x - y, x, x + y, y, y - x};  // counter-clockwise from min x
+      for (std::size_t k = 0; k < 8; ++k) {
+        if (key[k] > best[k]) {
+          best[k] = key[k];
+          ext[k] = i;
+        }
+      }
+    }
+    scratch.clear();
+    for (const P2& p : all) {
+      bool inside = true;
+      for (std::size_t k = 0; k < 8 && inside; ++k) inside = cross(all[ext[k]], all[ext[(k + 1) % 8]], p) > 0.0;
+      if (!inside) scratch.push_back(p);  // on or outside an edge: may be on the hull (corners are kept)
+    }
+  } else {
+    scratch.assign(all.begin(), all.end());
+  }
+  sort_points(scratch, hs);
   std::span<P2> pts(scratch);
   const std::size_t n = pts.size();
-  std::sort(pts.begin(), pts.end());
   if (n <= 1) {
     hull.assign(pts.begin(), pts.end());
     return;
@@ -44,7 +117,7 @@ void convex_hull(std::span<const P2> all, std::vector<P2>& hull, std::vector<P2>
   if (hull.size() == 2 && hull[0] == hull[1]) hull.resize(1);
 }
 
-OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, std::vector<P2>& scratch) {
+OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, HullScratch& scratch) {
   OrientedRect r;
   if (pts.empty()) return r;
   convex_hull(pts, hull, scratch);
@@ -99,9 +172,11 @@ OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, std::
   // carry the most points, i.e. the faces the sensor saw. Ties keep the first (deterministic).
   const Candidate* best = nullptr;
   std::size_t best_score = 0;
-  for (std::size_t k = 0; k < count; ++k) {
+  std::size_t scored = 0;
+  for (std::size_t k = 0; k < count && scored < 4; ++k) {  // (a circle-like hull ties everywhere: 4 suffice)
     const Candidate& c = cand[k];
     if (c.area > best_area * 1.01 + 1e-12) continue;
+    ++scored;
     const double tol = std::max(0.05, 0.02 * std::max(c.u1 - c.u0, c.v1 - c.v0));
     std::size_t score = 0;
     for (const P2& p : pts) {

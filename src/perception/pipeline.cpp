@@ -42,7 +42,8 @@ struct Pipeline::Impl {
   Buffer<std::uint8_t> above_guessed;
   Clusters clusters;
   std::vector<LabeledPoint> labeled;
-  std::vector<std::array<float, 2>> footprint, hull, hull_scratch;
+  std::vector<std::array<float, 2>> footprint, hull;
+  HullScratch hull_scratch;
 };
 
 Pipeline::Pipeline(const PipelineParams& params) : impl_(std::make_unique<Impl>(params)) {}

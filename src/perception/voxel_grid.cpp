@@ -10,7 +10,6 @@
 namespace fieldguard::perception {
 namespace {
 
-constexpr std::uint32_t kNoVoxel = 0xFFFFFFFFU;
 // Voxel coordinates are packed in 20 bits each (offset by 2^19), the range band in the top 4 bits, so no key
 // is all ones: that marks an empty ring-cache entry.
 constexpr std::int32_t kCoordOffset = 1 << 19;

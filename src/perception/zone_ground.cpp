@@ -166,8 +166,7 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
     const float dist = std::sqrt(dx * dx + dy * dy);
     if (dist > kSecantMin_m) {
       const float ux = dx / dist, uy = dy / dist;
-      const float secant =
-          (f.plane.z_at(f.mean_x, f.mean_y) - prior.plane.z_at(prior.ref_x, prior.ref_y)) / dist;
+      const float secant = (f.plane.z_at(f.mean_x, f.mean_y) - prior.plane.z_at(prior.ref_x, prior.ref_y)) / dist;
       const float along = prior.plane.a * ux + prior.plane.b * uy;
       guide.a += (secant - along) * ux;
       guide.b += (secant - along) * uy;

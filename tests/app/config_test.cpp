@@ -81,6 +81,56 @@ TEST(ConfigFiles, FieldguardUsesTheFieldMethods) {
   EXPECT_EQ(p.ground.zones.rings.size() + 1, p.ground.zones.edges_m.size());
 }
 
+// The perception module's defaults are fieldguard.yaml's (tests and benchmarks use PipelineParams{}): every
+// value the file sets equals the default.
+TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
+  const auto r = load_config_file(std::string(FIELDGUARD_SOURCE_DIR) + "/config/fieldguard.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& p = r.config.perception;
+  const perception::PipelineParams d;
+  EXPECT_EQ(p.voxel.leaf_m, d.voxel.leaf_m);
+  EXPECT_EQ(p.voxel.coarse_from_m, d.voxel.coarse_from_m);
+  EXPECT_EQ(p.voxel.max_leaf_m, d.voxel.max_leaf_m);
+  EXPECT_EQ(p.roi.min, d.roi.min);
+  EXPECT_EQ(p.roi.max, d.roi.max);
+  EXPECT_EQ(p.body.min, d.body.min);
+  EXPECT_EQ(p.body.max, d.body.max);
+  EXPECT_EQ(p.ground.method, d.ground.method);
+  EXPECT_EQ(p.ground.ransac.iterations, d.ground.ransac.iterations);
+  EXPECT_EQ(p.ground.ransac.distance_m, d.ground.ransac.distance_m);
+  EXPECT_EQ(p.ground.ransac.seed, d.ground.ransac.seed);
+  const auto &z = p.ground.zones, &dz = d.ground.zones;
+  EXPECT_EQ(z.edges_m, dz.edges_m);
+  EXPECT_EQ(z.rings, dz.rings);
+  EXPECT_EQ(z.sectors, dz.sectors);
+  EXPECT_EQ(z.min_bin_points, dz.min_bin_points);
+  EXPECT_EQ(z.seed_lowest, dz.seed_lowest);
+  EXPECT_EQ(z.seed_margin_m, dz.seed_margin_m);
+  EXPECT_EQ(z.fit_distance_m, dz.fit_distance_m);
+  EXPECT_EQ(z.fit_iterations, dz.fit_iterations);
+  EXPECT_EQ(z.ground_threshold_m, dz.ground_threshold_m);
+  EXPECT_EQ(z.max_slope_deg, dz.max_slope_deg);
+  EXPECT_EQ(z.max_tilt_deg, dz.max_tilt_deg);
+  EXPECT_EQ(z.max_step_m, dz.max_step_m);
+  EXPECT_EQ(z.max_slope_change_deg, dz.max_slope_change_deg);
+  EXPECT_EQ(z.min_spread_m, dz.min_spread_m);
+  EXPECT_EQ(z.max_extrapolation_m, dz.max_extrapolation_m);
+  EXPECT_EQ(z.sensor_height_m, dz.sensor_height_m);  // lidar.mounting.z_m 0.95
+  EXPECT_EQ(p.cluster.method, d.cluster.method);
+  EXPECT_EQ(p.cluster.structure, d.cluster.structure);
+  EXPECT_EQ(p.cluster.tolerance_m, d.cluster.tolerance_m);
+  EXPECT_EQ(p.cluster.beam_spacing_deg, d.cluster.beam_spacing_deg);
+  EXPECT_EQ(p.cluster.beam_factor, d.cluster.beam_factor);
+  EXPECT_EQ(p.cluster.max_tolerance_m, d.cluster.max_tolerance_m);
+  EXPECT_EQ(p.filters.min_points, d.filters.min_points);
+  EXPECT_EQ(p.filters.max_points, d.filters.max_points);
+  EXPECT_EQ(p.filters.min_volume_m3, d.filters.min_volume_m3);
+  EXPECT_EQ(p.filters.max_volume_m3, d.filters.max_volume_m3);
+  EXPECT_EQ(p.filters.min_height_m, d.filters.min_height_m);
+  EXPECT_EQ(p.filters.min_points_full_range_m, d.filters.min_points_full_range_m);
+  EXPECT_EQ(p.filters.min_points_floor, d.filters.min_points_floor);
+}
+
 TEST(ConfigLoad, ReadsEveryPerceptionKey) {
   const auto r = load_config_text(R"(
 lidar:

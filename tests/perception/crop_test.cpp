@@ -49,7 +49,8 @@ TEST(CropBox, DropsNanAndInfinity) {
   ASSERT_EQ(out.size(), 1U);
   EXPECT_FLOAT_EQ(out.x[0], 5.0F);
   // An infinite ROI lets only finite points through too.
-  const Box3 everything{{-inf, -inf, -inf}, {inf, inf, inf}};
+  const double dinf = std::numeric_limits<double>::infinity();
+  const Box3 everything{{-dinf, -dinf, -dinf}, {dinf, dinf, dinf}};
   crop_box(in, everything, kBody, out);
   EXPECT_EQ(out.size(), 1U);
 }

@@ -23,7 +23,8 @@ std::vector<P2> rectangle(float yaw) {
 }
 
 TEST(MinAreaRect, OfARotatedRectangle) {
-  std::vector<P2> hull, scratch;
+  std::vector<P2> hull;
+  HullScratch scratch;
   for (const float deg : {0.F, 30.F, -60.F, 89.F, 135.F}) {
     auto pts = rectangle(deg * std::numbers::pi_v<float> / 180.F);
     const OrientedRect r = min_area_rect(pts, hull, scratch);
@@ -39,7 +40,8 @@ TEST(MinAreaRect, OfARotatedRectangle) {
 }
 
 TEST(MinAreaRect, DegenerateFootprints) {
-  std::vector<P2> hull, scratch;
+  std::vector<P2> hull;
+  HullScratch scratch;
   std::vector<P2> one{{3.F, 4.F}};
   OrientedRect r = min_area_rect(one, hull, scratch);
   EXPECT_FLOAT_EQ(r.center[0], 3.F);
@@ -61,14 +63,16 @@ TEST(MinAreaRect, DegenerateFootprints) {
 
 TEST(ConvexHull, CounterClockwiseWithoutCollinearPoints) {
   std::vector<P2> pts{{0, 0}, {1, 0}, {2, 0}, {2, 2}, {1, 1}, {0, 2}, {1, 2}};
-  std::vector<P2> hull, scratch;
+  std::vector<P2> hull;
+  HullScratch scratch;
   convex_hull(pts, hull, scratch);
   EXPECT_EQ(hull, (std::vector<P2>{{0, 0}, {2, 0}, {2, 2}, {0, 2}}));
 }
 
 // Many points, a disc and a ring of them: every point inside or on the hull, every vertex an input point.
 TEST(ConvexHull, ContainsEveryPoint) {
-  std::vector<P2> pts, hull, scratch, small_hull, small_scratch;
+  std::vector<P2> pts, hull;
+  HullScratch scratch;
   for (int i = 0; i < 400; ++i) {
     const float a = 0.0157F * static_cast<float>(i * 7 % 400),
                 r = (i % 4 == 0) ? 2.F : 1.F + 0.002F * static_cast<float>(i);
@@ -88,6 +92,11 @@ TEST(ConvexHull, ContainsEveryPoint) {
   }
   for (const auto& v : hull) EXPECT_NE(std::find(pts.begin(), pts.end(), v), pts.end());
   EXPECT_GE(hull.size(), 20U);
+  // The same hull from the radix-sorted path (over 256 points) as from the comparison sort (a subset of the
+  // same points, whose hull must contain no point outside the full hull).
+  std::vector<P2> few(pts.begin(), pts.begin() + 200), few_hull;
+  convex_hull(few, few_hull, scratch);
+  for (const auto& p : few_hull) EXPECT_NE(std::find(pts.begin(), pts.end(), p), pts.end());
 }
 
 TEST(SizeClass, PersonSizedIsSmall) {
@@ -112,7 +121,8 @@ TEST(MinAreaRect, TwoFacesSeenAtACornerGiveTheBox) {
     std::vector<P2> pts;
     for (float u = 0.F; u <= 4.0001F; u += 0.1F) pts.push_back({c * u, s * u});    // long face
     for (float v = 0.1F; v <= 2.6001F; v += 0.1F) pts.push_back({-s * v, c * v});  // short face
-    std::vector<P2> hull, scratch;
+    std::vector<P2> hull;
+    HullScratch scratch;
     const OrientedRect r = min_area_rect(pts, hull, scratch);
     EXPECT_NEAR(r.length_m, 4.F, 1e-3F) << yaw;
     EXPECT_NEAR(r.width_m, 2.6F, 1e-3F) << yaw;

@@ -19,10 +19,16 @@ namespace {
 double deg(double rad) { return rad * 180.0 / std::numbers::pi; }
 
 // Angle between two plane normals, sign-free.
-double normal_angle_deg(double ax, double ay, double az, double bx, double by, double bz) {
+double normal_angle_deg_d(double ax, double ay, double az, double bx, double by, double bz) {
   const double c = std::fabs(ax * bx + ay * by + az * bz) /
                    (std::sqrt(ax * ax + ay * ay + az * az) * std::sqrt(bx * bx + by * by + bz * bz));
   return deg(std::acos(std::min(1.0, c)));
+}
+
+// Any mix of float and double arguments (the plane's coefficients are float).
+template <typename... T>
+double normal_angle_deg(T... v) {
+  return normal_angle_deg_d(static_cast<double>(v)...);
 }
 
 // Ground tilted by the vehicle's roll and pitch (z = a x + b y + c), with noise, and objects standing on it.

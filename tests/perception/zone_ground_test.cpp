@@ -44,7 +44,7 @@ TEST(ZoneGround, FindsATiltedPlaneWithinOneDegree) {
   for (float x = 3.F; x < 30.F; x += 1.5F) {
     for (float y = -9.F; y <= 9.F; y += 1.5F) {
       // The ground under (x, y) in the sensor frame (sensor 0.95 m above the ground at the origin).
-      const auto truth = static_cast<float>(scene.terrain.z(x, y) - scene.sensor_height_m);
+      const auto truth = static_cast<float>(scene.terrain.z(static_cast<double>(x), static_cast<double>(y)) - scene.sensor_height_m);
       EXPECT_NEAR(zones.ground_z(x, y), truth, 0.06F) << x << ", " << y;
       if (!zones.fitted_at(x, y)) continue;
       ++fitted;
@@ -126,7 +126,7 @@ TEST(ZoneGround, RidgeOnASlopeIsNotGroundAndNotAnObstacle) {
   EXPECT_NEAR(with_people.obstacles[0].height_above_ground_m, 1.47F, 0.2F);
   EXPECT_NEAR(with_people.obstacles[1].height_above_ground_m, 1.3F, 0.2F);
   for (const float x : {15.F, 30.F}) {
-    EXPECT_NEAR(pipe.ground_z(x, 0.F), static_cast<float>(scene.terrain.z(x, 0.0) - scene.sensor_height_m), 0.15F);
+    EXPECT_NEAR(pipe.ground_z(x, 0.F), static_cast<float>(scene.terrain.z(static_cast<double>(x), 0.0) - scene.sensor_height_m), 0.15F);
   }
 }
 

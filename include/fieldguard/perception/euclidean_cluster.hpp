@@ -7,7 +7,7 @@
 // 3D range (ClusterParams); two points join when nearer than the larger of their two radii, which is
 // symmetric, so the clusters do not depend on the search order. Structures: KdTree (our k-d tree, the
 // published way) or Grid (points counting-sorted into x-y columns of the smallest radius; a search scans the
-// neighbouring columns, skipping those already taken). Both find exactly the same clusters.
+// points of the neighbouring columns not yet in a cluster). Both find exactly the same clusters.
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
 
@@ -69,8 +69,14 @@ class EuclideanClusterer {
   };
   Buffer<GridPoint> grid_points_;
   Buffer<float> sorted_r2_;         // r2_ in grid order
-  Buffer<std::uint32_t> grid_col_;  // column of each point in grid order
-  Buffer<std::uint32_t> col_left_;  // per column: points not yet in a cluster
+  Buffer<std::uint32_t> col_next_;  // per column: its first point not yet in a cluster
+  struct Member {                   // a point taken into the cluster being grown
+    float x, y, z;
+    std::uint32_t index;
+    float r2;
+  };
+  Buffer<Member> members_;
+  Buffer<std::uint8_t> mark_;
 };
 
 }  // namespace fieldguard::perception

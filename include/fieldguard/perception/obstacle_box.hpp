@@ -4,6 +4,7 @@
 // size class.
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -22,18 +23,24 @@ struct OrientedRect {
   float yaw_rad = 0.F;  // of the length axis from x, counter-clockwise, in (-pi/2, pi/2]
 };
 
+// Working space of convex_hull() and min_area_rect(), reused across calls.
+struct HullScratch {
+  std::vector<std::array<float, 2>> points;
+  std::vector<std::uint64_t> keys, keys_tmp;
+  std::vector<std::uint32_t> counts;
+};
+
 // Convex hull of `pts` counter-clockwise without collinear points, from the lowest-leftmost point (Andrew's
-// monotone chain). `scratch` is working space.
+// monotone chain; points inside the Akl-Toussaint octagon left out first; large sets sorted by radix).
 void convex_hull(std::span<const std::array<float, 2>> pts, std::vector<std::array<float, 2>>& hull,
-                 std::vector<std::array<float, 2>>& scratch);
+                 HullScratch& scratch);
 
 // Minimum-area rectangle around `pts`; `hull` and `scratch` are working space. One point: a rectangle of size
 // zero at it; collinear points: width zero. Among rectangles within 1 % of the least area, the one whose sides
 // carry the most points (two faces seen at a corner make a right-triangle hull, whose leg- and
 // hypotenuse-aligned rectangles have the same area); remaining ties keep the first hull edge (deterministic).
 [[nodiscard]] OrientedRect min_area_rect(std::span<const std::array<float, 2>> pts,
-                                         std::vector<std::array<float, 2>>& hull,
-                                         std::vector<std::array<float, 2>>& scratch);
+                                         std::vector<std::array<float, 2>>& hull, HullScratch& scratch);
 
 [[nodiscard]] SizeClass size_class(float length_m, float width_m, float height_m);
 

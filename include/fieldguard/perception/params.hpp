@@ -62,7 +62,7 @@ struct ZoneParams {
   // Ground farther than this from any bin fitted to its own points is a guess (no ring reached it): a cluster
   // standing only on such ground counts its own vertical extent as its height above ground.
   double max_extrapolation_m = 20.0;
-  double sensor_height_m = 0.95;      // the LiDAR above flat ground; the loader copies lidar.mounting.z_m
+  double sensor_height_m = 0.95;  // the LiDAR above flat ground; the loader copies lidar.mounting.z_m
 };
 
 struct GroundParams {

@@ -3,16 +3,22 @@
 // concentric zone model), each bin's plane grown out of the plane of the bin inside it.
 //
 // Bins are visited from the sensor outwards. A bin's prior is the plane of the bin just inside it (for the
-// innermost ring: one plane fitted to that whole ring, starting level at -sensor_height). Seeds are the bin's
-// lowest points measured along the prior's slope; a plane z = a x + b y + c is fitted to them by least
-// squares with the prior's slope as a prior (so a bin seen by one scan ring, whose points hardly spread across
-// the ring, keeps the slope of the bin inside it and fits only its height), then refitted to the points near it. The
-// bin keeps its own plane only when it is a ground plane: not steeper than max_slope_deg, its points spread over at
-// least min_spread_m (a person's legs do not), and its height continues the prior's (within max_step_m plus the rise of
-// max_slope_change_deg over the distance between them: a haystack, a crop block, a building do not). Otherwise it
-// continues the prior's plane; and once every bin is done, a bin without its own plane gets the planes of the fitted
-// bins inside and outside it blended by distance. Every point then gets its height above its bin's plane; below
-// ground_threshold_m it is ground. The surface is kept, so ground_z(x, y) answers for any (x, y).
+// innermost ring: one plane fitted to that whole ring, starting level at -sensor_height, its tilt within
+// max_tilt_deg). Seeds are the bin's lowest points measured along the prior's slope. A plane z = a x + b y + c
+// is fitted to them by least squares with a slope prior: the prior's slope, except along the line from where
+// the prior was fitted to these points, where it is the rise between the two (far out, rings reach the
+// ground metres apart, and their heights are what shows the ground bending). A bin seen by one scan ring,
+// whose points hardly spread across the ring, so keeps that slope and fits only its height. It is then
+// refitted to the points within fit_distance_m below and half that above it (the ground is the lower
+// envelope: a ridge's flank does not draw the plane up). The bin keeps its own plane only when it is a
+// ground plane: not steeper than max_slope_deg, its slope within max_slope_change_deg of the prior's, its
+// points spread over at least min_spread_m (a person's legs do not), and its height continuing the prior's
+// (within max_step_m plus the rise of max_slope_change_deg over the distance: a haystack, a crop block, a
+// building do not). Otherwise it continues the prior's plane. Once every bin is done, a bin without its own
+// plane gets the planes around it (continued from inside, the first fitted bin outside it, the nearest fitted
+// ones either side in its ring) blended by inverse distance. Every point then gets its height above its bin's
+// plane, is ground below ground_threshold_m, and is flagged `guessed` where its bin's ground lies farther than
+// max_extrapolation_m from any measured ground. The surface is kept: ground_z(x, y) answers for any (x, y).
 // Thread-compatible.
 
 #include <cstdint>
