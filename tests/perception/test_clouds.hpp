@@ -8,6 +8,7 @@
 
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/perception/cloud.hpp"
+#include "perception/random.hpp"
 
 namespace fieldguard::perception::testing {
 
@@ -27,17 +28,14 @@ inline std::vector<LidarPoint> to_lidar(const Cloud& c) {
   return out;
 }
 
-// Deterministic uniform numbers (SplitMix64), for random clouds that are the same on every platform.
+// Deterministic uniform numbers, for random clouds that are the same on every platform: the pipeline's own
+// SplitMix64 (perception/random.hpp), with a float range on top.
 struct TestRng {
-  std::uint64_t s;
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31U);
-  }
+  SplitMix64 gen;
+  explicit TestRng(std::uint64_t seed) : gen(seed) {}
+  std::uint64_t next() { return gen.next(); }
   float uniform(float lo, float hi) {
-    return lo + (hi - lo) * static_cast<float>(static_cast<double>(next() >> 40U) * 0x1.0p-24);
+    return lo + (hi - lo) * static_cast<float>(static_cast<double>(gen.next() >> 40U) * 0x1.0p-24);
   }
 };
 
