@@ -90,6 +90,10 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
   std::printf("replay summary: %s\n", pcap.c_str());
   std::printf("  records read      %llu\n", static_cast<unsigned long long>(ps.records));
   std::printf("  udp datagrams     %llu\n", static_cast<unsigned long long>(ps.datagrams));
+  if (ps.ip_length_repaired != 0) {
+    std::printf("  ip length repaired %llu (IP total length past the frame; UDP length used)\n",
+                static_cast<unsigned long long>(ps.ip_length_repaired));
+  }
   std::printf("  data packets      %llu read, %llu decoded\n", static_cast<unsigned long long>(c.packets),
               static_cast<unsigned long long>(c.decoded));
   std::printf("  position packets  %llu read, %llu decoded, %llu with RMC\n",

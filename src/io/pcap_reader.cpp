@@ -152,6 +152,7 @@ std::optional<UdpDatagram> PcapReader::next() {
         continue;
       }
       ++stats_.datagrams;
+      if (result->ip_length_repaired) ++stats_.ip_length_repaired;
       return std::move(result).value();
     }
     impl_->done = true;

@@ -118,8 +118,12 @@ Expected<UdpDatagram, FrameDrop> extract_udp(int link_type, ByteSpan frame, std:
   if (version != 4 || header_len < kIpv4MinHeader || header_len > ip.size()) {
     return Unexpected{FrameDrop::BadIpHeader};
   }
-  const std::size_t total_len = load_be16(ip, 2);
-  if (total_len < header_len || total_len > ip.size()) return Unexpected{FrameDrop::BadIpHeader};
+  std::size_t total_len = load_be16(ip, 2);
+  if (total_len < header_len) return Unexpected{FrameDrop::BadIpHeader};
+  // The record is whole (checked above), so a total length past its end is the sender's error, not a
+  // cut: fall back to what the record holds and let the UDP length decide (checked below).
+  const bool repaired = total_len > ip.size();
+  if (repaired) total_len = ip.size();
 
   // The protocol byte is in every fragment, so a fragmented non-UDP datagram counts as NotUdp.
   if (ip[9] != kIpProtoUdp) return Unexpected{FrameDrop::NotUdp};
@@ -131,7 +135,9 @@ Expected<UdpDatagram, FrameDrop> extract_udp(int link_type, ByteSpan frame, std:
   const ByteSpan ip_payload = ip.subspan(header_len, total_len - header_len);
   if (ip_payload.size() < kUdpHeader) return Unexpected{FrameDrop::BadUdpLength};
   const std::size_t udp_len = load_be16(ip_payload, 4);
-  if (udp_len < kUdpHeader || udp_len > ip_payload.size()) return Unexpected{FrameDrop::BadUdpLength};
+  if (udp_len < kUdpHeader || udp_len > ip_payload.size()) {
+    return Unexpected{repaired ? FrameDrop::BadIpHeader : FrameDrop::BadUdpLength};
+  }
 
   UdpDatagram d;
   d.host_time = host_time;
@@ -140,6 +146,7 @@ Expected<UdpDatagram, FrameDrop> extract_udp(int link_type, ByteSpan frame, std:
   d.src_port = load_be16(ip_payload, 0);
   d.dst_port = load_be16(ip_payload, 2);
   d.payload = ip_payload.subspan(kUdpHeader, udp_len - kUdpHeader);
+  d.ip_length_repaired = repaired;
   return d;
 }
 

@@ -324,5 +324,22 @@ TEST(PcapReaderRealData, Hdl32eCapture) {
   EXPECT_EQ(r.stats().read_error, "");
 }
 
+TEST(PcapReaderRealData, Vlp16PositionPacketsWithImpossibleIpLength) {
+  // tests/data/vlp16_veloview_300.pcap (PROVENANCE.txt): 253 data packets and 47 position packets whose
+  // IP header claims 1234 bytes in a 554-byte frame. Every one is used; only the position packets are
+  // counted as repaired.
+  PcapReader r = open_ok(FIELDGUARD_TEST_DATA "/vlp16_veloview_300.pcap");
+  std::map<std::uint16_t, std::map<std::size_t, int>> by_port;
+  std::map<std::uint16_t, int> repaired;
+  while (auto d = r.next()) {
+    ++by_port[d->dst_port][d->payload.size()];
+    if (d->ip_length_repaired) ++repaired[d->dst_port];
+  }
+  EXPECT_EQ(by_port, (std::map<std::uint16_t, std::map<std::size_t, int>>{{2368, {{1206, 253}}}, {8308, {{512, 47}}}}));
+  EXPECT_EQ(repaired, (std::map<std::uint16_t, int>{{8308, 47}}));
+  EXPECT_EQ(r.stats().ip_length_repaired, 47U);
+  EXPECT_EQ(r.stats().drops[static_cast<std::size_t>(FrameDrop::BadIpHeader)], 0U);
+}
+
 }  // namespace
 }  // namespace fieldguard::io

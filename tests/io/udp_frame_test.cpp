@@ -45,6 +45,32 @@ TEST(UdpFrame, EthernetDatagramFields) {
   EXPECT_EQ(payload_bytes(*r), d.payload);
 }
 
+// The VLP-16's position packets claim an IP total length of 1234 in a 554-byte frame (real captures:
+// tests/data/vlp16_veloview_300.pcap). The record is whole, the UDP length (520) fits: the datagram is
+// used and flagged, and a normal one is not flagged.
+TEST(UdpFrame, ImpossibleTotalLengthFallsBackToTheUdpLength) {
+  Ipv4Udp d = velodyne_data();
+  d.src_port = 8308;
+  d.dst_port = 8308;
+  d.payload = testing::pattern(512, 5);
+  d.total_length = 1234;
+  const Bytes frame = testing::ethernet(testing::build(d));
+  ASSERT_EQ(frame.size(), 554U);
+  const auto r = extract(kLinkEthernet, frame);
+  ASSERT_TRUE(r.has_value()) << to_string(r.error());
+  EXPECT_TRUE(r->ip_length_repaired);
+  EXPECT_EQ(payload_bytes(*r), d.payload);
+
+  const auto normal = extract(kLinkEthernet, testing::ethernet(testing::build(velodyne_data())));
+  ASSERT_TRUE(normal.has_value());
+  EXPECT_FALSE(normal->ip_length_repaired);
+
+  // The same frame cut by the snaplen stays a truncated record: only a whole record is repaired.
+  const auto cut = extract_udp(kLinkEthernet, frame, 600, Stamp{1});
+  ASSERT_FALSE(cut.has_value());
+  EXPECT_EQ(cut.error(), FrameDrop::TruncatedRecord);
+}
+
 struct DecodeCase {
   std::string name;
   int link_type;
@@ -188,9 +214,13 @@ std::vector<DropCase> drop_cases() {
   cases.push_back({"ip_header_cut", kLinkEthernet, cut(testing::ethernet(ip), 14 + 19), 0, FrameDrop::BadIpHeader});
   cases.push_back({"ihl_past_frame", kLinkRaw, cut(testing::build(with([](Ipv4Udp& d) { d.ihl = 15; })), 40), 0,
                    FrameDrop::BadIpHeader});
-  cases.push_back({"total_length_past_frame", kLinkEthernet,
-                   eth(with([&](Ipv4Udp& d) { d.total_length = static_cast<std::uint16_t>(ip_size + 1); })), 0,
-                   FrameDrop::BadIpHeader});
+  // A total length past the whole record is trusted no further than the UDP length: when that does not
+  // fit either, the header is bad (see ImpossibleTotalLengthFallsBackToTheUdpLength for when it fits).
+  cases.push_back({"total_length_past_frame_udp_too", kLinkEthernet, eth(with([&](Ipv4Udp& d) {
+                     d.total_length = static_cast<std::uint16_t>(ip_size + 1);
+                     d.udp_length = static_cast<std::uint16_t>(ip_size - 20 + 1);
+                   })),
+                   0, FrameDrop::BadIpHeader});
   cases.push_back({"total_length_below_header", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.total_length = 19; })), 0,
                    FrameDrop::BadIpHeader});
   cases.push_back({"total_length_below_options", kLinkRaw, testing::build(with([](Ipv4Udp& d) {

@@ -23,6 +23,10 @@ struct UdpDatagram {
   std::uint16_t src_port = 0;
   std::uint16_t dst_port = 0;
   ByteSpan payload;            // points into the caller's frame buffer
+  // The IP header's total length claimed more bytes than the whole, uncut record holds, and the UDP
+  // length (which fits) was trusted instead. Velodyne VLP-16 firmware sends its 8308 position packets
+  // so (IP total length 1234 in a 554-byte frame: the real captures in tests/data show it). Counted.
+  bool ip_length_repaired = false;
 };
 
 // Why a captured frame yielded no datagram. Every one is counted by the reader.
