@@ -154,6 +154,7 @@ std::vector<std::pair<std::string, std::uint64_t>> pcap_drops(const io::PcapStat
 void add_pcap_stats(const io::PcapStats& stats, Summary& summary) {
   summary.extra.emplace_back("pcap_records", stats.records);
   summary.extra.emplace_back("datagrams", stats.datagrams);
+  summary.extra.emplace_back("ip_length_repaired", stats.ip_length_repaired);
   if (stats.truncated) summary.notes.emplace_back("truncated", "the file ends inside a record (a capture cut short)");
   if (!stats.read_error.empty()) {
     summary.notes.emplace_back("stopped", "reading stopped at a damaged record: " + stats.read_error);

@@ -112,15 +112,26 @@ TEST(InspectVelodyne, Vlp16DetectedDespiteTheHdl32eProductByte) {
   const auto run = run_fieldguard("inspect " + arg(kData + "vlp16_veloview_300.pcap"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto r = testing::json_lines(run.output);
-  ASSERT_EQ(r.size(), 253U);
+  ASSERT_EQ(r.size(), 300U);
   EXPECT_NE(run.output.find("  model              VLP-16 (spacing 1327 us"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("product byte 0x21 (HDL-32E) is what early VLP-16 firmware reports"), std::string::npos);
   EXPECT_EQ(r[0]["product_byte"].integer(), 0x21);
-  for (const auto& rec : r) EXPECT_LE(rec["points"].integer(), 384);  // 12 blocks x 32 slots
+  std::size_t positions = 0;
+  for (const auto& rec : r) {
+    if (rec["type"].text == "velodyne_position") {
+      ++positions;
+      EXPECT_EQ(rec["port"].integer(), 8308);
+    } else {
+      EXPECT_LE(rec["points"].integer(), 384);  // 12 blocks x 32 slots
+    }
+  }
   EXPECT_EQ(total_points(r), summary_number(run.output, "points"));
-  // This unit's 47 position packets claim an IP total length of 1234 in a 554-byte frame: dropped by the reader.
-  EXPECT_EQ(summary_number(run.output, "bad_ip_header"), 47);
-  EXPECT_EQ(summary_number(run.output, "velodyne_position"), 0);
+  // This unit's 47 position packets claim an IP total length of 1234 in a 554-byte frame: the records are
+  // whole, so the reader trusts the UDP length, decodes them and counts the repair.
+  EXPECT_EQ(positions, 47U);
+  EXPECT_EQ(summary_number(run.output, "velodyne_position"), 47);
+  EXPECT_EQ(summary_number(run.output, "ip_length_repaired"), 47);
+  EXPECT_EQ(summary_number(run.output, "bad_ip_header"), 0);
   EXPECT_EQ(summary_number(run.output, "no_model"), 0);
 }
 
