@@ -8,6 +8,7 @@
 #include <string>
 #include <variant>
 
+#include "app/inspect_byte_log.hpp"
 #include "app/inspect_format.hpp"
 #include "app/json_line.hpp"
 #include "fieldguard/drivers/nmea_stream.hpp"
@@ -98,6 +99,11 @@ std::string record(const nmea::Sentence& sentence) {
 }  // namespace
 
 bool looks_like_nmea(ByteSpan head) {
+  if (starts_with_byte_log(head)) {
+    // What `fieldguard record` saves of the serial line; the source line names it ("gnss /dev/ttyUSB0 ...").
+    const std::string source = byte_log_source(head);
+    return source.find("gnss") != std::string::npos || source.find("nmea") != std::string::npos || source.find("gps") != std::string::npos;
+  }
   // Text starting with a sentence or a comment line (gpsd logs), after blank space.
   const auto first = std::find_if(head.begin(), head.end(), [](std::uint8_t b) {
     return b != ' ' && b != '\t' && b != '\r' && b != '\n';
@@ -127,9 +133,22 @@ void inspect_nmea(Capture& in, Output& out, Summary& summary) {
     }
     sentences.clear();
   };
-  in.for_each_chunk([&](ByteSpan chunk) {
-    parser.push(chunk, sentences);
+  // A byte log of the serial line (`fieldguard record`), or the raw bytes.
+  bool first = true;
+  bool byte_log = false;
+  ByteLogFeed feed([&](ByteSpan bytes, Stamp) {
+    parser.push(bytes, sentences);
     take();
+  });
+  in.for_each_chunk([&](ByteSpan chunk) {
+    if (first) byte_log = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
+    first = false;
+    if (byte_log) {
+      feed.push(chunk);
+    } else {
+      parser.push(chunk, sentences);
+      take();
+    }
   });
   parser.finish(sentences);
   take();
@@ -138,6 +157,7 @@ void inspect_nmea(Capture& in, Output& out, Summary& summary) {
                         {"too_long", c.too_long},         {"bad_field", c.bad_field},
                         {"unsupported", c.unsupported},   {"interrupted", c.interrupted}};
   summary.extra = {{"sentences", c.sentences}, {"noise_bytes", c.noise_bytes}};
+  if (byte_log) feed.finish(summary);
 }
 
 }  // namespace fieldguard::app::inspect

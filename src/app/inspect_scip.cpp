@@ -11,18 +11,14 @@
 #include <string_view>
 #include <vector>
 
+#include "app/inspect_byte_log.hpp"
 #include "app/inspect_format.hpp"
 #include "app/json_line.hpp"
 #include "fieldguard/drivers/scip.hpp"
 #include "fieldguard/drivers/scip_data.hpp"
-#include "fieldguard/io/byte_log.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {
-
-constexpr std::string_view kMagic(io::kByteLogMagic, sizeof io::kByteLogMagic - 1);
-constexpr std::size_t kRecordHeaderSize = 13;  // u64 host_ns, u32 length, u8 direction
-constexpr std::size_t kMaxSourceLine = 4096;   // as io::ByteLogReader
 
 bool is_single_scan(scip::Command c) {
   using C = scip::Command;
@@ -137,125 +133,13 @@ class Decoder {
   std::uint64_t from_sensor_bytes_ = 0;
 };
 
-// The byte log's records, chunk by chunk (the layout of io/byte_log.hpp; io::ByteLogReader reads whole files by
-// path, inspect also reads pipes). Sensor bytes go to the decoder as they come, with their record's host time.
-class ByteLogFeed {
- public:
-  explicit ByteLogFeed(Decoder& decoder) : decoder_(decoder) {}
-
-  void push(ByteSpan chunk) {
-    std::size_t i = 0;
-    while (i < chunk.size() && state_ != State::Stopped) {
-      switch (state_) {
-        case State::Magic:
-          header_ += static_cast<char>(chunk[i++]);
-          if (header_.size() == kMagic.size()) {
-            if (header_ != kMagic) return stop("not a fieldguard byte log (no FGBYTELOG1 header)", true);
-            state_ = State::Source;
-          }
-          break;
-        case State::Source: {
-          const char c = static_cast<char>(chunk[i++]);
-          if (c == '\n') {
-            state_ = State::RecordHeader;
-          } else if (source_.size() >= kMaxSourceLine) {
-            return stop("the byte log's header line is too long", true);
-          } else {
-            source_ += c;
-          }
-          break;
-        }
-        case State::RecordHeader:
-          record_header_[filled_++] = chunk[i++];
-          if (filled_ == kRecordHeaderSize) start_record();
-          break;
-        case State::RecordBody: {
-          const std::size_t n = std::min<std::size_t>(remaining_, chunk.size() - i);
-          if (from_sensor_) {
-            decoder_.push(chunk.subspan(i, n), seconds_of(time_));
-          } else {
-            to_sensor_bytes_ += n;
-          }
-          i += n;
-          remaining_ -= static_cast<std::uint32_t>(n);  // n <= remaining_
-          if (remaining_ == 0) end_record();
-          break;
-        }
-        case State::Stopped: break;
-      }
-    }
-  }
-
-  void finish(Summary& summary) {
-    summary.extra.emplace_back("log_records", records_);
-    summary.extra.emplace_back("to_sensor_bytes", to_sensor_bytes_);
-    if (state_ == State::Magic || state_ == State::Source) {
-      if (!unusable_) summary.unusable = "the byte log's header is cut short";
-    } else if ((state_ == State::RecordHeader && filled_ > 0) || state_ == State::RecordBody) {
-      summary.notes.emplace_back("truncated", "the file ends inside a record (a log cut short)");
-    }
-    if (unusable_) summary.unusable = stopped_;
-    if (!unusable_ && !stopped_.empty()) summary.notes.emplace_back("stopped", stopped_);
-    summary.notes.emplace_back("source", "byte log \"" + source_ + "\"");
-  }
-
- private:
-  enum class State : std::uint8_t { Magic, Source, RecordHeader, RecordBody, Stopped };
-
-  void stop(std::string why, bool unusable) {
-    stopped_ = std::move(why);
-    unusable_ = unusable;
-    state_ = State::Stopped;
-  }
-  void start_record() {
-    filled_ = 0;
-    const ByteSpan h(record_header_);
-    time_ = Stamp{static_cast<std::int64_t>(static_cast<std::uint64_t>(load_le32(h, 0)) |
-                                            (static_cast<std::uint64_t>(load_le32(h, 4)) << 32))};
-    remaining_ = load_le32(h, 8);
-    const std::uint8_t direction = record_header_[12];
-    if (remaining_ > io::kByteLogMaxRecord || direction > 1) {
-      return stop("corrupt record " + std::to_string(records_ + 1) + " (length " + std::to_string(remaining_) +
-                      ", direction " + std::to_string(direction) + "): the rest of the file is not read",
-                  false);
-    }
-    from_sensor_ = direction == static_cast<std::uint8_t>(io::Direction::FromSensor);
-    state_ = State::RecordBody;
-    if (remaining_ == 0) end_record();
-  }
-  void end_record() {
-    ++records_;
-    state_ = State::RecordHeader;
-  }
-
-  Decoder& decoder_;
-  State state_ = State::Magic;
-  std::string header_;
-  std::string source_;
-  std::array<std::uint8_t, kRecordHeaderSize> record_header_{};
-  std::size_t filled_ = 0;
-  Stamp time_;
-  std::uint32_t remaining_ = 0;
-  bool from_sensor_ = true;
-  std::uint64_t records_ = 0;
-  std::uint64_t to_sensor_bytes_ = 0;
-  std::string stopped_;
-  bool unusable_ = false;
-};
-
-bool starts_with_magic(ByteSpan head) {
-  return head.size() >= kMagic.size() && std::equal(kMagic.begin(), kMagic.end(), head.begin());
-}
 
 }  // namespace
 
 bool looks_like_scip(ByteSpan head) {
-  if (starts_with_magic(head)) {
+  if (starts_with_byte_log(head)) {
     // The source line names the sensor: "scip 192.168.0.10:10940", "scan2d ...".
-    std::string source;
-    for (std::size_t i = kMagic.size(); i < head.size() && head[i] != '\n'; ++i) {
-      source += static_cast<char>(std::tolower(head[i]));
-    }
+    const std::string source = byte_log_source(head);
     return source.find("scip") != std::string::npos || source.find("scan2d") != std::string::npos ||
            source.find("hokuyo") != std::string::npos;
   }
@@ -272,9 +156,9 @@ void inspect_scip(Capture& in, Output& out, Summary& summary) {
   Decoder decoder(out, summary);
   bool first = true;
   bool byte_log = false;
-  ByteLogFeed feed(decoder);
+  ByteLogFeed feed([&](ByteSpan bytes, Stamp host_time) { decoder.push(bytes, seconds_of(host_time)); });
   in.for_each_chunk([&](ByteSpan chunk) {
-    if (first) byte_log = starts_with_magic(chunk);  // the first chunk is the head the format was guessed from
+    if (first) byte_log = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
     first = false;
     if (byte_log) {
       feed.push(chunk);

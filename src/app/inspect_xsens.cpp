@@ -6,6 +6,7 @@
 #include <string>
 #include <variant>
 
+#include "app/inspect_byte_log.hpp"
 #include "app/inspect_format.hpp"
 #include "app/json_line.hpp"
 #include "fieldguard/drivers/xsens_stream.hpp"
@@ -149,6 +150,11 @@ std::string record(const xs::RawMessage& m) {
 }  // namespace
 
 bool looks_like_xsens(ByteSpan head) {
+  if (starts_with_byte_log(head)) {
+    // What `fieldguard record` saves of the serial line; the source line names it ("ahrs /dev/ttyUSB0 ...").
+    const std::string source = byte_log_source(head);
+    return source.find("ahrs") != std::string::npos || source.find("xsens") != std::string::npos || source.find("mti") != std::string::npos;
+  }
   // A complete, valid Xbus frame anywhere in the first bytes, or an MTData2 header.
   for (std::size_t i = 0; i + 2 < head.size(); ++i) {
     if (head[i] != xs::kPreamble || head[i + 1] != xs::kBusMaster) continue;
@@ -173,9 +179,22 @@ void inspect_xsens(Capture& in, Output& out, Summary& summary) {
     }
     items.clear();
   };
-  in.for_each_chunk([&](ByteSpan chunk) {
-    parser.push(chunk, items);
+  // A byte log of the serial line (`fieldguard record`), or the raw bytes.
+  bool first = true;
+  bool byte_log = false;
+  ByteLogFeed feed([&](ByteSpan bytes, Stamp) {
+    parser.push(bytes, items);
     take();
+  });
+  in.for_each_chunk([&](ByteSpan chunk) {
+    if (first) byte_log = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
+    first = false;
+    if (byte_log) {
+      feed.push(chunk);
+    } else {
+      parser.push(chunk, items);
+      take();
+    }
   });
   parser.finish(items);
   take();
@@ -186,6 +205,7 @@ void inspect_xsens(Capture& in, Output& out, Summary& summary) {
                         {"bad_packet_size", c.bad_packet_size},
                         {"truncated_frame", c.truncated_frame}};
   summary.extra = {{"unknown_data_ids", c.unknown_data_ids}, {"garbage_bytes", c.garbage_bytes}};
+  if (byte_log) feed.finish(summary);
 }
 
 }  // namespace fieldguard::app::inspect
