@@ -1,5 +1,6 @@
 // libFuzzer target for the Velodyne data packet path: header check, decoders (HDL-32E / VLP-16, both timestamp
-// references), model detection, sensor time and rotation assembly. Traps on any broken output invariant.
+// references), model detection, sensor time and rotation assembly, and velodyne::Stream (detection, decoding in
+// place into the frame under construction, frame recycling). Traps on any broken output invariant.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -8,6 +9,7 @@
 
 #include "fieldguard/drivers/rotation_assembler.hpp"
 #include "fieldguard/drivers/velodyne_decoder.hpp"
+#include "fieldguard/drivers/velodyne_stream.hpp"
 
 namespace {
 
@@ -136,5 +138,57 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& q : frames[i].points) check(std::isfinite(q.time_s));
   }
   check(assembler.frames_emitted() == frames.size());
+
+  // The same packets through two velodyne::Streams (model detected from the stream, decoding in place): one
+  // recycles every frame as soon as it has it, the other never does. Reused buffers must not change a single
+  // point, and the counters must add up.
+  velodyne::StreamOptions options;
+  options.rotation_cut_deg = cut_deg;
+  options.max_undecided_packets = 4;
+  velodyne::Stream recycling(options);
+  velodyne::Stream keeping(options);
+  std::vector<LidarFrame> kept;
+  std::vector<LidarFrame> out;
+  std::vector<LidarFrame> seen;  // copies of what the recycling stream emitted
+  host = host0;
+  const auto take = [&](std::vector<LidarFrame>& got) {
+    for (LidarFrame& f : got) {
+      seen.push_back(f);
+      recycling.recycle(std::move(f));
+    }
+    got.clear();
+  };
+  for (const auto& p : stream) {
+    host += 552'960;
+    recycling.push(p, Stamp{host}, out);
+    take(out);
+    keeping.push(p, Stamp{host}, kept);
+  }
+  recycling.finish(out);
+  take(out);
+  keeping.finish(kept);
+  check(seen.size() == kept.size());
+  std::uint64_t points = 0;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    check(seen[i].index == i && kept[i].index == i);
+    check(seen[i].points.size() == kept[i].points.size());
+    for (std::size_t j = 0; j < kept[i].points.size(); ++j) {
+      const LidarPoint& a = seen[i].points[j];
+      const LidarPoint& b = kept[i].points[j];
+      check(a.x == b.x && a.y == b.y && a.z == b.z && a.time_s == b.time_s && a.ring == b.ring &&
+            a.azimuth_cdeg == b.azimuth_cdeg && a.intensity == b.intensity);
+    }
+    const std::uint16_t rings = keeping.model() == Model::VLP16 ? 16 : 32;
+    for (const LidarPoint& q : kept[i].points) {
+      check(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.time_s));
+      check(q.ring < rings && q.range_m >= 0.5F && q.range_m <= 130.F);
+    }
+    points += kept[i].points.size();
+  }
+  const velodyne::StreamCounters& c = recycling.counters();
+  check(c.packets == stream.size());
+  check(c.decoded + c.rejected() == c.packets);
+  check(c.points == points);
+  check(c.full_rotations + c.partial_rotations == kept.size());
   return 0;
 }
