@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "fieldguard/drivers/scip.hpp"
+#include "options.hpp"
 
 namespace {
 
@@ -188,28 +189,18 @@ void serve(int fd, const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "%s needs a value\n%s", a.c_str(), kUsage);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--port") o.port = std::atoi(value().c_str());
-    else if (a == "--scene") o.obstacle = value() != "wall";
-    else if (a == "--drop-after") o.drop_after = std::atol(value().c_str());
-    else if (a == "--garbage-after") o.garbage_after = std::atol(value().c_str());
-    else if (a == "--refuse-laser") o.refuse_laser = true;
-    else if (a == "--max-clients") o.max_clients = std::atol(value().c_str());
-    else if (a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else {
-      std::fprintf(stderr, "unknown option %s\n%s", a.c_str(), kUsage);
-      return 2;
-    }
+  fieldguard::tools::Options opt(argc, argv, "fieldguard-scip-emulator", kUsage);
+  while (opt.next()) {
+    if (opt.is("--port")) o.port = static_cast<int>(opt.integer(0, 65535));
+    else if (opt.is("--scene")) {
+      const std::string scene = opt.text();
+      if (scene != "wall" && scene != "obstacle") opt.fail("--scene is wall or obstacle, not '" + scene + "'");
+      o.obstacle = scene == "obstacle";
+    } else if (opt.is("--drop-after")) o.drop_after = opt.integer(-1, 1'000'000'000);
+    else if (opt.is("--garbage-after")) o.garbage_after = opt.integer(-1, 1'000'000'000);
+    else if (opt.is("--refuse-laser")) o.refuse_laser = true;
+    else if (opt.is("--max-clients")) o.max_clients = opt.integer(-1, 1'000'000'000);
+    else opt.unknown();
   }
   const int srv = ::socket(AF_INET, SOCK_STREAM, 0);
   const int on = 1;

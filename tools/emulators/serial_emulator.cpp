@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include "options.hpp"
+
 namespace {
 
 constexpr const char* kUsage =
@@ -49,29 +51,16 @@ int main(int argc, char** argv) {
   unsigned long chunk = 64;
   unsigned long garbage_every = 0;
   double hold_open_s = 1.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "%s needs a value\n%s", a.c_str(), kUsage);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--file") file = value();
-    else if (a == "--baud") baud = std::stoul(value());
-    else if (a == "--loop") loops = std::stoul(value());
-    else if (a == "--chunk") chunk = std::max(1UL, std::stoul(value()));
-    else if (a == "--link") link = value();
-    else if (a == "--hold-open") hold_open_s = std::stod(value());
-    else if (a == "--garbage-every") garbage_every = std::stoul(value());
-    else if (a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else {
-      std::fprintf(stderr, "unknown option %s\n%s", a.c_str(), kUsage);
-      return 2;
-    }
+  fieldguard::tools::Options opt(argc, argv, "fieldguard-serial-emulator", kUsage);
+  while (opt.next()) {
+    if (opt.is("--file")) file = opt.text();
+    else if (opt.is("--baud")) baud = static_cast<unsigned long>(opt.integer(0, 4'000'000));
+    else if (opt.is("--loop")) loops = static_cast<unsigned long>(opt.integer(1, 1'000'000));
+    else if (opt.is("--chunk")) chunk = static_cast<unsigned long>(opt.integer(1, 1 << 20));
+    else if (opt.is("--link")) link = opt.text();
+    else if (opt.is("--hold-open")) hold_open_s = opt.number(0.0, 86400.0);
+    else if (opt.is("--garbage-every")) garbage_every = static_cast<unsigned long>(opt.integer(0, 1'000'000'000));
+    else opt.unknown();
   }
   if (file.empty()) return fail("--file is required");
   std::ifstream in(file, std::ios::binary);

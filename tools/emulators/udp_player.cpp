@@ -1,0 +1,150 @@
+// fieldguard-udp-player: plays the UDP datagrams of a capture (pcap or pcapng) to a host over real UDP
+// sockets, paced by the capture's own record times: a LiDAR on the bench for the daemon's live path and
+// its end-to-end tests. Each datagram goes to the port it was captured on, or to the port --map gives.
+// Prints "playing N datagrams" on stdout once the capture is read, then plays; prints a summary on stderr.
+// When the capture ends (and its loops), the player exits: the "sensor" falls silent.
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fieldguard/io/pcap_reader.hpp"
+#include "options.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: fieldguard-udp-player --pcap FILE [--host ADDR] [--map FROM:TO]... [--speed X] [--loop N]\n"
+    "                             [--delay SECONDS]\n"
+    "  --pcap FILE       the capture to play (pcap or pcapng; every UDP datagram in it)\n"
+    "  --host ADDR       IPv4 address to send to (default 127.0.0.1)\n"
+    "  --map FROM:TO     send datagrams captured on port FROM to port TO (default: the captured port);\n"
+    "                    datagrams on ports no --map names are skipped once any --map is given\n"
+    "  --speed X         1 = the capture's pace (default), 2 = twice as fast, 0 = as fast as possible\n"
+    "  --loop N          play the capture N times, each after the previous (default 1)\n"
+    "  --delay SECONDS   wait this long after printing the count before the first datagram (default 0)\n"
+    "Exit codes: 0 played, 1 a send failed, 2 bad command line or unreadable capture.\n";
+
+struct Datagram {
+  std::int64_t t_ns;  // record time
+  std::uint16_t port;
+  std::vector<std::uint8_t> payload;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string pcap;
+  std::string host = "127.0.0.1";
+  std::map<std::uint16_t, std::uint16_t> map;
+  double speed = 1.0;
+  long loops = 1;
+  double delay_s = 0.0;
+  fieldguard::tools::Options opt(argc, argv, "fieldguard-udp-player", kUsage);
+  while (opt.next()) {
+    if (opt.is("--pcap")) {
+      pcap = opt.text();
+    } else if (opt.is("--host")) {
+      host = opt.text();
+    } else if (opt.is("--map")) {
+      const std::string m = opt.text();
+      unsigned from = 0;
+      unsigned to = 0;
+      char tail = 0;
+      if (std::sscanf(m.c_str(), "%u:%u%c", &from, &to, &tail) != 2 || from > 65535 || to == 0 || to > 65535) {
+        opt.fail("--map takes FROM:TO ports, not '" + m + "'");
+      }
+      map[static_cast<std::uint16_t>(from)] = static_cast<std::uint16_t>(to);
+    } else if (opt.is("--speed")) {
+      speed = opt.number(0.0, 1000.0);
+    } else if (opt.is("--loop")) {
+      loops = opt.integer(1, 1'000'000);
+    } else if (opt.is("--delay")) {
+      delay_s = opt.number(0.0, 3600.0);
+    } else {
+      opt.unknown();
+    }
+  }
+  if (pcap.empty()) opt.fail("--pcap is required");
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  if (::inet_pton(AF_INET, host.c_str(), &to.sin_addr) != 1) opt.fail("--host takes an IPv4 address, not '" + host + "'");
+
+  auto reader = fieldguard::io::PcapReader::open(pcap);
+  if (!reader) {
+    std::fprintf(stderr, "fieldguard-udp-player: %s\n", reader.error().c_str());
+    return 2;
+  }
+  std::vector<Datagram> datagrams;
+  std::uint64_t skipped = 0;
+  while (auto d = reader->next()) {
+    std::uint16_t port = d->dst_port;
+    if (!map.empty()) {
+      const auto it = map.find(d->dst_port);
+      if (it == map.end()) {
+        ++skipped;
+        continue;
+      }
+      port = it->second;
+    }
+    datagrams.push_back({d->host_time.ns, port, {d->payload.begin(), d->payload.end()}});
+  }
+  if (!reader->stats().read_error.empty()) {
+    std::fprintf(stderr, "fieldguard-udp-player: %s: %s (playing what was read)\n", pcap.c_str(),
+                 reader->stats().read_error.c_str());
+  }
+  if (datagrams.empty()) {
+    std::fprintf(stderr, "fieldguard-udp-player: no datagram to play in %s\n", pcap.c_str());
+    return 2;
+  }
+
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) {
+    std::fprintf(stderr, "fieldguard-udp-player: socket: %s\n", std::strerror(errno));
+    return 1;
+  }
+  std::printf("playing %zu datagrams\n", datagrams.size());
+  std::fflush(stdout);
+  if (delay_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+
+  using Clock = std::chrono::steady_clock;
+  const std::int64_t span_ns = datagrams.back().t_ns - datagrams.front().t_ns;
+  // One capture period between loops, so that a looped capture keeps its packet spacing at the seam.
+  const std::int64_t period_ns =
+      span_ns + (datagrams.size() > 1 ? span_ns / static_cast<std::int64_t>(datagrams.size() - 1) : 0);
+  const Clock::time_point start = Clock::now();
+  std::uint64_t sent = 0;
+  for (long l = 0; l < loops; ++l) {
+    for (const Datagram& d : datagrams) {
+      if (speed > 0.0) {
+        const double offset_s = static_cast<double>(d.t_ns - datagrams.front().t_ns + l * period_ns) * 1e-9 / speed;
+        std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                                  std::chrono::duration<double>(offset_s)));
+      }
+      to.sin_port = htons(d.port);
+      if (::sendto(fd, d.payload.data(), d.payload.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) !=
+          static_cast<ssize_t>(d.payload.size())) {
+        std::fprintf(stderr, "fieldguard-udp-player: send to %s:%u failed after %llu datagrams: %s\n", host.c_str(),
+                     d.port, static_cast<unsigned long long>(sent), std::strerror(errno));
+        ::close(fd);
+        return 1;
+      }
+      ++sent;
+    }
+  }
+  ::close(fd);
+  const double took = std::chrono::duration<double>(Clock::now() - start).count();
+  std::fprintf(stderr, "fieldguard-udp-player: sent %llu datagrams in %.3f s (%llu skipped by --map)\n",
+               static_cast<unsigned long long>(sent), took, static_cast<unsigned long long>(skipped));
+  return 0;
+}
