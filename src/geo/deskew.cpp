@@ -1,0 +1,200 @@
+#include "fieldguard/geo/deskew.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "fieldguard/geo/attitude.hpp"
+
+namespace fieldguard::geo {
+
+namespace {
+
+struct Meta {
+  float intensity;
+  float time_s;
+  std::uint16_t channel;
+  PointSource source;
+};
+
+Meta meta_of(const LidarPoint& p) { return {p.intensity, p.time_s, p.ring, PointSource::Lidar3d}; }
+Meta meta_of(const SourcedPoint& p) { return {p.intensity, p.time_s, p.channel, p.source}; }
+
+std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+  std::int64_t q = a / b;
+  if ((a % b != 0) && ((a < 0) != (b < 0))) --q;
+  return q;
+}
+
+void count(DeskewStats& s, TrackError e) {
+  switch (e) {
+    case TrackError::Empty: ++s.dropped_no_pose; break;
+    case TrackError::BeforeStart: ++s.dropped_before_start; break;
+    case TrackError::AfterEnd: ++s.dropped_after_end; break;
+    case TrackError::Gap: ++s.dropped_gap; break;
+  }
+}
+
+// Sensor point -> target frame at one instant: v = r p + t.
+struct Xf {
+  Eigen::Matrix3d r;
+  Eigen::Vector3d t;
+  bool extrapolated;
+};
+
+// The target frame: plane (identity) or the level frame of t_ref: v_target = l (v_plane - origin).
+struct Target {
+  Eigen::Matrix3d l = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+};
+
+}  // namespace
+
+std::vector<std::string> DeskewParams::validate() const {
+  std::vector<std::string> problems;
+  const Mounting& m = lidar;
+  if (!std::isfinite(m.x_m) || !std::isfinite(m.y_m) || !std::isfinite(m.z_m) || !std::isfinite(m.roll_deg) ||
+      !std::isfinite(m.pitch_deg) || !std::isfinite(m.yaw_deg)) {
+    problems.emplace_back("lidar mounting: every value must be a finite number");
+  }
+  if (!std::isfinite(pose_step_s) || pose_step_s < 0.0 || pose_step_s > 0.01) {
+    problems.emplace_back("pose_step_s: must be 0 (exact) .. 0.01 s");
+  }
+  return problems;
+}
+
+Deskewer::Deskewer(const DeskewParams& params) : params_(params) {
+  const auto problems = params.validate();
+  if (!problems.empty()) {
+    std::string msg = "invalid deskew parameters:";
+    for (const auto& p : problems) msg += "\n  " + p;
+    throw std::invalid_argument(msg);
+  }
+  const Eigen::Isometry3d m = transform_of(params.lidar);
+  lidar_r_ = m.linear();
+  lidar_t_ = m.translation();
+  step_ns_ = std::llround(params.pose_step_s * 1e9);
+}
+
+namespace {
+
+template <typename P, typename Emit>
+DeskewStats run(std::span<const P> points, Stamp base, const PoseTrack& track, const Target& target, bool use_positions,
+                const Eigen::Matrix3d& lidar_r, const Eigen::Vector3d& lidar_t, std::int64_t step_ns, Emit&& emit) {
+  DeskewStats stats;
+  stats.points_in = points.size();
+  std::int64_t last_key = std::numeric_limits<std::int64_t>::min();
+  Xf xf{};
+  bool have_xf = false;
+  TrackError last_error = TrackError::Empty;
+  for (const P& p : points) {
+    const Meta m = meta_of(p);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(m.time_s)) {
+      ++stats.dropped_not_finite;
+      continue;
+    }
+    const std::int64_t t_ns = base.ns + std::llround(static_cast<double>(m.time_s) * 1e9);
+    const std::int64_t key = step_ns > 0 ? floor_div(t_ns, step_ns) : t_ns;
+    if (key != last_key) {
+      last_key = key;
+      const Stamp at{step_ns > 0 ? key * step_ns + step_ns / 2 : t_ns};
+      have_xf = false;
+      auto q = track.attitude_at(at);
+      if (!q) {
+        last_error = q.error();
+      } else {
+        Eigen::Vector3d pos = Eigen::Vector3d::Zero();
+        bool extrapolated = q->extrapolated;
+        bool ok = true;
+        if (use_positions) {
+          auto pp = track.position_at(at);
+          if (!pp) {
+            last_error = pp.error();
+            ok = false;
+          } else {
+            pos = pp->p;
+            extrapolated = extrapolated || pp->extrapolated;
+          }
+        }
+        if (ok) {
+          const Eigen::Matrix3d r = q->q.toRotationMatrix();
+          xf.r = target.l * r * lidar_r;
+          xf.t = target.l * (r * lidar_t + pos - target.origin);
+          xf.extrapolated = extrapolated;
+          have_xf = true;
+        }
+      }
+    }
+    if (!have_xf) {
+      count(stats, last_error);
+      continue;
+    }
+    const Eigen::Vector3d v =
+        xf.r * Eigen::Vector3d(static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)) + xf.t;
+    emit(v, m, xf.extrapolated ? kExtrapolatedPose : std::uint8_t{0});
+    ++stats.points_out;
+    if (xf.extrapolated) ++stats.extrapolated;
+  }
+  return stats;
+}
+
+template <typename P>
+Expected<DeskewStats, DeskewError> level_impl(std::span<const P> points, Stamp base, const PoseTrack& track,
+                                              Stamp t_ref, bool use_positions, const Eigen::Matrix3d& lidar_r,
+                                              const Eigen::Vector3d& lidar_t, std::int64_t step_ns,
+                                              std::vector<SourcedPoint>& out) {
+  Target target;
+  auto q_ref = track.attitude_at(t_ref);
+  if (!q_ref) return Unexpected{DeskewError::NoReferencePose};
+  if (use_positions) {
+    auto p_ref = track.position_at(t_ref);
+    if (!p_ref) return Unexpected{DeskewError::NoReferencePose};
+    target.origin = p_ref->p;
+  }
+  target.l = Eigen::AngleAxisd(-horizontal_yaw_rad(q_ref->q), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  out.reserve(out.size() + points.size());
+  return run(
+      points, base, track, target, use_positions, lidar_r, lidar_t, step_ns,
+      [&out](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
+        out.push_back(SourcedPoint{static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
+                                   m.intensity, m.time_s, m.channel, m.source, flags});
+      });
+}
+
+template <typename P>
+DeskewStats plane_impl(std::span<const P> points, Stamp base, const PoseTrack& track, bool use_positions,
+                       const Eigen::Matrix3d& lidar_r, const Eigen::Vector3d& lidar_t, std::int64_t step_ns,
+                       std::vector<PlanePoint>& out) {
+  out.reserve(out.size() + points.size());
+  return run(points, base, track, Target{}, use_positions, lidar_r, lidar_t, step_ns,
+             [&out](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
+               out.push_back(PlanePoint{v, m.intensity, m.time_s, m.channel, m.source, flags});
+             });
+}
+
+}  // namespace
+
+Expected<DeskewStats, DeskewError> Deskewer::to_level(std::span<const LidarPoint> points, Stamp base,
+                                                      const PoseTrack& track, Stamp t_ref,
+                                                      std::vector<SourcedPoint>& out) const {
+  return level_impl(points, base, track, t_ref, params_.use_positions, lidar_r_, lidar_t_, step_ns_, out);
+}
+
+Expected<DeskewStats, DeskewError> Deskewer::to_level(std::span<const SourcedPoint> points, Stamp base,
+                                                      const PoseTrack& track, Stamp t_ref,
+                                                      std::vector<SourcedPoint>& out) const {
+  return level_impl(points, base, track, t_ref, params_.use_positions, lidar_r_, lidar_t_, step_ns_, out);
+}
+
+DeskewStats Deskewer::to_plane(std::span<const LidarPoint> points, Stamp base, const PoseTrack& track,
+                               std::vector<PlanePoint>& out) const {
+  return plane_impl(points, base, track, params_.use_positions, lidar_r_, lidar_t_, step_ns_, out);
+}
+
+DeskewStats Deskewer::to_plane(std::span<const SourcedPoint> points, Stamp base, const PoseTrack& track,
+                               std::vector<PlanePoint>& out) const {
+  return plane_impl(points, base, track, params_.use_positions, lidar_r_, lidar_t_, step_ns_, out);
+}
+
+}  // namespace fieldguard::geo
