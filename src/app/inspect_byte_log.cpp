@@ -112,4 +112,24 @@ void ByteLogFeed::end_record() {
   state_ = State::RecordHeader;
 }
 
+SensorBytes::SensorBytes(Sink sink)
+    : sink_(std::move(sink)), feed_([this](ByteSpan bytes, Stamp host_time) { sink_(bytes, host_time); }) {}
+
+void SensorBytes::read(Capture& in) {
+  bool first = true;
+  in.for_each_chunk([&](ByteSpan chunk) {
+    if (first) byte_log_ = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
+    first = false;
+    if (byte_log_) {
+      feed_.push(chunk);
+    } else {
+      sink_(chunk, std::nullopt);
+    }
+  });
+}
+
+void SensorBytes::finish(Summary& summary) {
+  if (byte_log_) feed_.finish(summary);
+}
+
 }  // namespace fieldguard::app::inspect

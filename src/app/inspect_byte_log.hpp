@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "app/inspect_format.hpp"
@@ -52,6 +53,27 @@ class ByteLogFeed {
   std::uint64_t to_sensor_bytes_ = 0;
   std::string stopped_;
   bool unusable_ = false;
+};
+
+// What the serial and TCP formats read: the sensor's bytes of a capture that is either a byte log (each record
+// from the sensor, with its host time) or the raw bytes themselves (no time).
+class SensorBytes {
+ public:
+  using Sink = std::function<void(ByteSpan bytes, std::optional<Stamp> host_time)>;
+  explicit SensorBytes(Sink sink);
+  SensorBytes(const SensorBytes&) = delete;  // the feed calls back into this object
+  SensorBytes& operator=(const SensorBytes&) = delete;
+
+  // Reads the whole capture; a byte log is told by its first bytes.
+  void read(Capture& in);
+  [[nodiscard]] bool byte_log() const { return byte_log_; }
+  // The byte log's counts and notes; nothing for raw bytes. Call after the format has filled in its own.
+  void finish(Summary& summary);
+
+ private:
+  Sink sink_;
+  ByteLogFeed feed_;
+  bool byte_log_ = false;
 };
 
 }  // namespace fieldguard::app::inspect

@@ -134,22 +134,11 @@ void inspect_nmea(Capture& in, Output& out, Summary& summary) {
     sentences.clear();
   };
   // A byte log of the serial line (`fieldguard record`), or the raw bytes.
-  bool first = true;
-  bool byte_log = false;
-  ByteLogFeed feed([&](ByteSpan bytes, Stamp) {
+  SensorBytes bytes_in([&](ByteSpan bytes, std::optional<Stamp>) {
     parser.push(bytes, sentences);
     take();
   });
-  in.for_each_chunk([&](ByteSpan chunk) {
-    if (first) byte_log = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
-    first = false;
-    if (byte_log) {
-      feed.push(chunk);
-    } else {
-      parser.push(chunk, sentences);
-      take();
-    }
-  });
+  bytes_in.read(in);
   parser.finish(sentences);
   take();
   const auto& c = parser.counters();
@@ -157,7 +146,7 @@ void inspect_nmea(Capture& in, Output& out, Summary& summary) {
                         {"too_long", c.too_long},         {"bad_field", c.bad_field},
                         {"unsupported", c.unsupported},   {"interrupted", c.interrupted}};
   summary.extra = {{"sentences", c.sentences}, {"noise_bytes", c.noise_bytes}};
-  if (byte_log) feed.finish(summary);
+  bytes_in.finish(summary);
 }
 
 }  // namespace fieldguard::app::inspect

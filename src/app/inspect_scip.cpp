@@ -154,24 +154,13 @@ bool looks_like_scip(ByteSpan head) {
 
 void inspect_scip(Capture& in, Output& out, Summary& summary) {
   Decoder decoder(out, summary);
-  bool first = true;
-  bool byte_log = false;
-  ByteLogFeed feed([&](ByteSpan bytes, Stamp host_time) { decoder.push(bytes, seconds_of(host_time)); });
-  in.for_each_chunk([&](ByteSpan chunk) {
-    if (first) byte_log = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
-    first = false;
-    if (byte_log) {
-      feed.push(chunk);
-    } else {
-      decoder.push(chunk, std::nullopt);
-    }
+  SensorBytes bytes_in([&](ByteSpan bytes, std::optional<Stamp> host_time) {
+    decoder.push(bytes, host_time ? std::optional<double>(seconds_of(*host_time)) : std::nullopt);
   });
+  bytes_in.read(in);
   decoder.summarise();
-  if (byte_log) {
-    feed.finish(summary);
-  } else {
-    summary.notes.emplace_back("source", "raw text of the sensor's replies (no host times)");
-  }
+  bytes_in.finish(summary);
+  if (!bytes_in.byte_log()) summary.notes.emplace_back("source", "raw text of the sensor's replies (no host times)");
 }
 
 }  // namespace fieldguard::app::inspect

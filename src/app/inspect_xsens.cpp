@@ -180,22 +180,11 @@ void inspect_xsens(Capture& in, Output& out, Summary& summary) {
     items.clear();
   };
   // A byte log of the serial line (`fieldguard record`), or the raw bytes.
-  bool first = true;
-  bool byte_log = false;
-  ByteLogFeed feed([&](ByteSpan bytes, Stamp) {
+  SensorBytes bytes_in([&](ByteSpan bytes, std::optional<Stamp>) {
     parser.push(bytes, items);
     take();
   });
-  in.for_each_chunk([&](ByteSpan chunk) {
-    if (first) byte_log = starts_with_byte_log(chunk);  // the first chunk is the head the format was guessed from
-    first = false;
-    if (byte_log) {
-      feed.push(chunk);
-    } else {
-      parser.push(chunk, items);
-      take();
-    }
-  });
+  bytes_in.read(in);
   parser.finish(items);
   take();
   const auto& c = parser.counters();
@@ -205,7 +194,7 @@ void inspect_xsens(Capture& in, Output& out, Summary& summary) {
                         {"bad_packet_size", c.bad_packet_size},
                         {"truncated_frame", c.truncated_frame}};
   summary.extra = {{"unknown_data_ids", c.unknown_data_ids}, {"garbage_bytes", c.garbage_bytes}};
-  if (byte_log) feed.finish(summary);
+  bytes_in.finish(summary);
 }
 
 }  // namespace fieldguard::app::inspect
