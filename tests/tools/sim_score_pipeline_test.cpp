@@ -1,0 +1,84 @@
+// The whole detection chain on a small simulated scene: fieldguard-sim writes a capture with its ground truth,
+// `fieldguard replay` runs config/fieldguard.yaml's pipeline over it, and the scorer holds the obstacles to the
+// truth. The scene is the rough field (clods up to 40 cm, a 35 cm ridge, 3.5 degrees of roll and 3 of pitch)
+// with the pedestrian crossing at 5 to 30 m: a ground segmentation that takes the ridge or clods for obstacles,
+// or a clustering that splits or drops the far pedestrian's few returns, fails it.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "score/frames.hpp"
+#include "score/metrics.hpp"
+#include "tools/tools_test_support.hpp"
+
+namespace fieldguard::score {
+namespace {
+
+using tools_test::run;
+using tools_test::ScratchDir;
+
+// Six rotations per crossing (5, 10, ..., 30 m): a few seconds of CPU even in a sanitizer Debug build.
+constexpr int kRotations = 36;
+
+struct Outcome {
+  ScoreReport report;
+  std::string log;
+};
+
+Outcome sim_replay_score(const std::string& config, const ScratchDir& dir) {
+  Outcome o;
+  const std::string pcap = dir.file("scene.pcap");
+  const std::string truth = dir.file("scene.truth.jsonl");
+  const std::string obstacles = dir.file("scene.obstacles.jsonl");
+  const auto sim = run(FIELDGUARD_SIM, "--scene rough-pedestrian --rotations " + std::to_string(kRotations) +
+                                           " --seed 1 --quiet --pcap '" + pcap + "'");
+  EXPECT_EQ(sim.exit_code, 0) << sim.errors;
+  const auto replay = run(FIELDGUARD_BINARY, "replay --quiet --config '" + config + "' --pcap '" + pcap +
+                                                 "' --obstacles-out '" + obstacles + "'");
+  EXPECT_EQ(replay.exit_code, 0) << replay.errors;
+  o.log = sim.errors + replay.errors;
+  std::vector<TruthFrame> t;
+  std::vector<DetectionFrame> d;
+  std::string error;
+  EXPECT_TRUE(read_truth(truth, t, error)) << error;
+  EXPECT_TRUE(read_detections(obstacles, d, error)) << error;
+  o.report = score(t, d, ScoreParams{});
+  return o;
+}
+
+TEST(SimScorePipeline, RoughFieldPedestrianCrossingsWithOurConfig) {
+  const ScratchDir dir("sim_score_pipeline");
+  const Outcome o = sim_replay_score(std::string(FIELDGUARD_CONFIG_DIR) + "/fieldguard.yaml", dir);
+  const ScoreReport& r = o.report;
+  ASSERT_EQ(r.matched_frames, static_cast<std::size_t>(kRotations)) << o.log;
+  ASSERT_GE(r.scored_frames, static_cast<std::size_t>(kRotations - 2));  // the first and last are partial
+
+  // Every crossing is seen in every scored frame at 5-25 m, and at 30 m (side-on, a handful of returns) in all
+  // but one. (On the full scene the acceptance is >= 99 % and >= 97 %; six frames a band allow no finer.)
+  std::uint64_t visible = 0, missed = 0;
+  for (std::size_t b = 1; b <= 6; ++b) {
+    const Rate& p = r.pedestrian[b];
+    EXPECT_GE(p.total, 4U) << "band " << band_name(b) << ": the scene has a crossing in every band";
+    visible += p.total;
+    missed += p.total - p.hits;
+    if (b <= 5) {
+      EXPECT_EQ(p.hits, p.total) << "pedestrian missed in band " << band_name(b);
+    }
+  }
+  EXPECT_GE(visible, 30U);
+  EXPECT_LE(missed, 1U) << "pedestrian frames missed: " << missed << " of " << visible;
+  // One person, one obstacle: at 25-30 m an HDL-32E's rings cross the body 0.6-0.7 m apart, and a radius that
+  // does not grow with range makes one cluster per ring.
+  EXPECT_EQ(r.over_segmented, 0U);
+
+  // Nothing but the pedestrian is an obstacle here: clods, the ridge and the tilted ground are terrain.
+  std::string causes;
+  for (const auto& [cause, n] : r.false_causes) causes += " " + cause + " " + std::to_string(n);
+  EXPECT_LE(r.false_obstacles, 1U) << "false obstacles, by what they lie on:" << causes;
+  EXPECT_EQ(r.under_segmented, 0U);
+}
+
+}  // namespace
+}  // namespace fieldguard::score
