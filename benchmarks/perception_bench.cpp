@@ -1,10 +1,10 @@
 // Obstacle detection, each stage and the whole pipeline, side by side with the stock-PCL way of doing the
-// same step, in the same run on the same frames:
-//   bench_perception [--benchmark_filter=...] [--benchmark_min_time=...]
-// Frames: a synthetic HDL-32E rotation over a bordered field (benchmarks/synthetic_scene.hpp) at 10 Hz
-// (~69,000 points) and 5 Hz (~137,000 points); or rotations of the scene simulator given as PCD files:
-//   fieldguard-sim --scene shed --rate 10 --pcap s10.pcap;  fieldguard replay --config ... --pcap s10.pcap
-//   --pcd-dir d10;  bench_perception --frame10=d10/frame_000005.pcd --frame5=d5/frame_000005.pcd
+// same step, in the same run on the same frames, and packets to obstacles:
+//   bench_perception [--benchmark_filter=...]
+// Frames: rotations of the scene simulator (tools/sim, linked in, run at start: nothing to download or keep),
+// decoded from its UDP payloads by our velodyne::Stream: the `shed` scene at 10 Hz (~69,300 points) and 5 Hz
+// (~138,600 points), the acceptance frames (nearly every ray returns); and, as a field for comparison, the
+// `pedestrian` scene at 10 and 5 Hz (a person crossing at 10 m; the sky returns nothing).
 // Every iteration runs ours three times, then PCL's three times, on the same input, timing each with the
 // thread's CPU clock (and std::chrono for wall time). Counters: medians of the warm runs (after a run of the
 // same side) and of the cold ones (the first after the other side's), and their ratios (x_faster_than_pcl,
@@ -12,6 +12,8 @@
 // Settings: config/fieldguard.yaml and config/published.yaml through the app's loader; stock PCL with the
 // published values (CropBox ROI and negative body box, VoxelGrid 0.15 m, SACSegmentation plane RANSAC 60
 // iterations 0.3 m, EuclideanClusterExtraction 0.6 m over search::KdTree with 10..240 points).
+// Packets to obstacles: the rotation's UDP payloads pushed into velodyne::Stream, the rotation it emits through
+// the fieldguard.yaml pipeline (one thread, buffers reused across rotations as the daemon does).
 #include <benchmark/benchmark.h>
 #include <pcl/ModelCoefficients.h>
 #include <pcl/common/common.h>
@@ -40,13 +42,14 @@
 #include <vector>
 
 #include "fieldguard/app/config.hpp"
+#include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/perception/ransac_ground.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
 #include "fieldguard/perception/zone_ground.hpp"
-#include "synthetic_scene.hpp"
+#include "sim_frames.hpp"
 
 namespace {
 
@@ -78,7 +81,8 @@ const PipelineParams& published() {
 
 struct Frame {
   std::string name;
-  std::vector<LidarPoint> points;
+  std::vector<sim::TimedPacket> packets;  // the rotation's UDP payloads
+  std::vector<LidarPoint> points;         // as velodyne::Stream decodes them
   PclCloud::Ptr pcl_points{new PclCloud};
   // Our stage inputs (published settings, so both sides see the same data sizes).
   Cloud cropped, voxels, above;
@@ -173,50 +177,29 @@ std::size_t pcl_pipeline(const PclCloud::Ptr& in) {
   return obstacles;
 }
 
-// Frames from files, when given: --frame10=FILE --frame5=FILE, binary PCD as `fieldguard replay --pcd-dir`
-// writes them (fields x y z intensity ring time), e.g. of the simulator's `shed` scene.
-std::string& frame_file(int which) {
-  static std::string files[2];
-  return files[which];
-}
+// The frames: simulator scene, rate, the rotation taken, the rotations of the scene (pedestrian: one crossing
+// per two rotations, the second crossing at 10 m).
+struct FrameSpec {
+  const char* name;
+  const char* scene;
+  double hz;
+  std::uint64_t rotation;
+  int scene_rotations;
+};
+constexpr FrameSpec kFrames[] = {
+    {"shed 10Hz", "shed", 10.0, 1, 3},
+    {"shed 5Hz", "shed", 5.0, 1, 3},
+    {"field 10Hz", "pedestrian", 10.0, 3, 12},
+    {"field 5Hz", "pedestrian", 5.0, 3, 12},
+};
+constexpr int kFrameCount = 4;
 
-std::vector<LidarPoint> load_pcd(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto data = s.find("DATA binary\n");
-  const auto count_at = s.find("\nPOINTS ");
-  if (!in.good() && s.empty()) throw std::runtime_error("cannot read " + path);
-  if (data == std::string::npos || count_at == std::string::npos ||
-      s.find("FIELDS x y z intensity ring time") == std::string::npos) {
-    throw std::runtime_error(path + ": not a fieldguard binary PCD (FIELDS x y z intensity ring time)");
-  }
-  const std::size_t count = std::stoul(s.substr(count_at + 8));
-  constexpr std::size_t kStride = 22;  // 4 + 4 + 4 + 4 + 2 + 4 bytes
-  const std::size_t begin = data + 12;
-  if (s.size() < begin + count * kStride) throw std::runtime_error(path + ": shorter than its POINTS");
-  std::vector<LidarPoint> out(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const char* d = s.data() + begin + i * kStride;
-    std::memcpy(&out[i].x, d, 4);
-    std::memcpy(&out[i].y, d + 4, 4);
-    std::memcpy(&out[i].z, d + 8, 4);
-    std::memcpy(&out[i].intensity, d + 12, 4);
-    std::memcpy(&out[i].ring, d + 16, 2);
-    std::memcpy(&out[i].time_s, d + 18, 4);
-  }
-  return out;
-}
-
-Frame make_frame(const char* name, double hz, const std::string& file) {
+Frame make_frame(const FrameSpec& spec) {
   Frame f;
-  f.name = name;
-  if (!file.empty()) {
-    f.points = load_pcd(file);
-  } else {
-    sim::ScanSpec spec;
-    spec.rotation_hz = hz;
-    f.points = sim::scan(sim::benchmark_scene(), spec);
-  }
+  f.name = spec.name;
+  bench::SimRotation r = bench::simulate_rotation(spec.scene, spec.hz, spec.rotation, spec.scene_rotations);
+  f.packets = std::move(r.packets);
+  f.points = std::move(r.points);
   for (const auto& p : f.points) f.pcl_points->push_back(pcl::PointXYZ(p.x, p.y, p.z));
   const PipelineParams& p = published();
   crop_box(f.points, p.roi, p.body, f.cropped);
@@ -241,9 +224,12 @@ Frame make_frame(const char* name, double hz, const std::string& file) {
 }
 
 Frame& frame(int which) {
-  static Frame f10 = make_frame("10Hz", 10.0, frame_file(0));
-  static Frame f5 = make_frame("5Hz", 5.0, frame_file(1));
-  return which == 0 ? f10 : f5;
+  static std::vector<Frame> frames = [] {
+    std::vector<Frame> v;
+    for (const FrameSpec& spec : kFrames) v.push_back(make_frame(spec));
+    return v;
+  }();
+  return frames.at(static_cast<std::size_t>(which));
 }
 
 // ---- paired timing ----
@@ -429,8 +415,54 @@ void BM_PipelineFieldguard(benchmark::State& state) {
   pipeline_bench(state, "PIPELINE fieldguard.yaml", fieldguard_params());
 }
 
-constexpr double kMinTime = 0.5;  // seconds of our own (manual) time per benchmark
-#define FG_BENCH(fn) BENCHMARK(fn)->Arg(0)->Arg(1)->UseManualTime()->MinTime(kMinTime)->Unit(benchmark::kMicrosecond)
+// Packets to obstacles: the UDP payloads of the rotation into velodyne::Stream, the rotation it emits through
+// the fieldguard.yaml pipeline. The stream and the pipeline live across runs as in the daemon: each run pushes
+// the rotation's packets, and the first packet (azimuth 0) completes the rotation pushed by the run before,
+// which is then processed; frame buffers go back to the stream. One rotation decoded and detected per run.
+void BM_PacketsToObstacles(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  velodyne::Stream stream(bench::sim_stream_options());
+  Pipeline pipe(fieldguard_params());
+  std::vector<LidarFrame> done;
+  std::size_t processed = 0, obstacles = 0;
+  const auto run = [&] {
+    for (auto& d : done) stream.recycle(std::move(d));
+    done.clear();
+    for (const auto& p : f.packets) stream.push(ByteSpan(p.bytes.data(), p.bytes.size()), Stamp{p.pcap_time_ns}, done);
+    for (const auto& d : done) {
+      const auto r = pipe.process(d.points);
+      obstacles = r.obstacles.size();
+      ++processed;
+      benchmark::DoNotOptimize(r.obstacles.data());
+    }
+  };
+  run();  // the first push only starts a rotation
+  paired(state, "PACKETS -> obstacles", static_cast<int>(state.range(0)), f.points.size(), run, {});
+  state.counters["obstacles"] = static_cast<double>(obstacles);
+  if (processed == 0) state.SkipWithError("velodyne::Stream emitted no rotation");
+}
+
+// Decoding alone: the same packets into velodyne::Stream.
+void BM_Decode(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  velodyne::Stream stream(bench::sim_stream_options());
+  std::vector<LidarFrame> done;
+  const auto run = [&] {
+    for (auto& d : done) stream.recycle(std::move(d));
+    done.clear();
+    for (const auto& p : f.packets) stream.push(ByteSpan(p.bytes.data(), p.bytes.size()), Stamp{p.pcap_time_ns}, done);
+    benchmark::DoNotOptimize(done.data());
+  };
+  run();
+  paired(state, "decode (velodyne::Stream)", static_cast<int>(state.range(0)), f.points.size(), run, {});
+}
+
+// Iterations per benchmark, each three runs of ours and three of PCL's: 60 timed runs a side, enough for
+// steady medians, and a whole run stays within minutes on a loaded 2-core machine (the stock-PCL pipeline
+// takes ~40 ms on the shed).
+constexpr int kIterations = 20;
+#define FG_BENCH(fn) \
+  BENCHMARK(fn)->DenseRange(0, kFrameCount - 1)->UseManualTime()->Iterations(kIterations)->Unit(benchmark::kMicrosecond)
 FG_BENCH(BM_Crop);
 FG_BENCH(BM_Voxel);
 FG_BENCH(BM_GroundRansac);
@@ -440,25 +472,29 @@ FG_BENCH(BM_ClusterFixedGrid);
 FG_BENCH(BM_ClusterAdaptiveGrid);
 FG_BENCH(BM_PipelinePublished);
 FG_BENCH(BM_PipelineFieldguard);
+FG_BENCH(BM_Decode);
+FG_BENCH(BM_PacketsToObstacles);
 
 void print_summary() {
   if (rows().empty()) return;
-  std::printf("\nFrames: 10Hz %zu points (%s), 5Hz %zu points (%s).\n", frame(0).points.size(),
-              frame_file(0).empty() ? "synthetic HDL-32E, benchmarks/synthetic_scene.hpp" : frame_file(0).c_str(),
-              frame(1).points.size(),
-              frame_file(1).empty() ? "synthetic HDL-32E, benchmarks/synthetic_scene.hpp" : frame_file(1).c_str());
+  std::printf("\nFrames (fieldguard-sim scenes, seed 1, decoded by velodyne::Stream):");
+  for (int i = 0; i < kFrameCount; ++i) {
+    std::printf(" %s = %s rotation %llu, %zu points%s", kFrames[i].name, kFrames[i].scene,
+                static_cast<unsigned long long>(kFrames[i].rotation), frame(i).points.size(),
+                i + 1 < kFrameCount ? ";" : ".\n");
+  }
   std::printf(
       "Medians of thread CPU time in us. warm: runs after a run of the same side; cold: the first run\n"
       "after the other side's (caches and branch history theirs). PCL: the stock classes, same input.\n");
-  std::printf("%-30s %-5s %7s | %8s %8s %6s | %8s %8s %6s | %8s %8s\n", "stage", "frame", "pts in", "ours", "pcl",
+  std::printf("%-30s %-10s %7s | %8s %8s %6s | %8s %8s %6s | %8s %8s\n", "stage", "frame", "pts in", "ours", "pcl",
               "x warm", "ours", "pcl", "x cold", "ours wall", "pcl wall");
   for (const Row& r : rows()) {
     if (r.pcl_cpu > 0.0) {
-      std::printf("%-30s %-5s %7zu | %8.1f %8.1f %6.2f | %8.1f %8.1f %6.2f | %8.1f %8.1f\n", r.stage.c_str(),
+      std::printf("%-30s %-10s %7zu | %8.1f %8.1f %6.2f | %8.1f %8.1f %6.2f | %8.1f %8.1f\n", r.stage.c_str(),
                   r.frame.c_str(), r.points_in, r.ours_cpu, r.pcl_cpu, r.pcl_cpu / r.ours_cpu, r.ours_cold, r.pcl_cold,
                   r.pcl_cold / r.ours_cold, r.ours_wall, r.pcl_wall);
     } else {
-      std::printf("%-30s %-5s %7zu | %8.1f %8s %6s | %8.1f %8s %6s | %8.1f %8s\n", r.stage.c_str(), r.frame.c_str(),
+      std::printf("%-30s %-10s %7zu | %8.1f %8s %6s | %8.1f %8s %6s | %8.1f %8s\n", r.stage.c_str(), r.frame.c_str(),
                   r.points_in, r.ours_cpu, "-", "-", r.ours_cold, "-", "-", r.ours_wall, "-");
     }
   }
@@ -467,19 +503,6 @@ void print_summary() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Our own flags first (Google Benchmark refuses flags it does not know).
-  int kept = 1;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a.rfind("--frame10=", 0) == 0) {
-      frame_file(0) = a.substr(10);
-    } else if (a.rfind("--frame5=", 0) == 0) {
-      frame_file(1) = a.substr(9);
-    } else {
-      argv[kept++] = argv[i];
-    }
-  }
-  argc = kept;
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -9,10 +9,22 @@
 namespace fieldguard::perception {
 namespace {
 
-// The grid never has more columns than this many per point (and at least kMinCells): a sparse, wide cloud
-// gets larger columns, and searches then scan more points; the clusters stay the same.
-constexpr std::size_t kCellsPerPoint = 8;
-constexpr std::size_t kMinCells = 16384;
+// The grid's x-y column table has at most this many columns per point (and at least kMinColumns); a cloud
+// spread wider (not one a region of interest has cut) is clustered over the k-d tree instead: same clusters.
+constexpr std::size_t kColumnsPerPoint = 16;
+constexpr std::size_t kMinColumns = std::size_t{1} << 20;
+// Metres by which a gap between two cells is taken short: a point's cell comes from (v - lo) / edge in float,
+// and that rounding must not make a cell pair look farther apart than two of its points are.
+constexpr float kSlack = 1e-3F;
+
+// Union-find over cells: the root of `c`, halving the path on the way.
+inline std::uint32_t find_root(std::uint32_t* parent, std::uint32_t c) {
+  while (parent[c] != c) {
+    parent[c] = parent[parent[c]];
+    c = parent[c];
+  }
+  return c;
+}
 
 }  // namespace
 
@@ -135,131 +147,185 @@ void EuclideanClusterer::extract_kdtree(const Cloud& in, Clusters& out) {
   }
 }
 
-// Columns: the x-y plane in squares of the smallest radius (larger if that would make more than
-// kCellsPerPoint per point). A search scans the free points of the columns within its radius.
+// Cells: cubes of edge a bit under tolerance / sqrt(3), so that any two points of one cell are nearer than the
+// smallest radius and join. A cell is therefore a piece of one cluster, and clustering is union-find over
+// cells: two neighbouring cells join when any pair of their points is within the pair's radius (the test
+// stops at the first such pair, and is skipped when the two are already joined). A dense surface (a wall,
+// a shed's roof) thus costs a few tests per cell instead of a radius search per point. The connected components
+// are those of the point graph, so the clusters are exactly the k-d tree's.
 void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   const std::size_t n = in.size();
-  float lo[2] = {in.x[0], in.y[0]};
-  float hi[2] = {lo[0], lo[1]};
-  for (std::size_t i = 1; i < n; ++i) {
-    lo[0] = std::min(lo[0], in.x[i]);
-    hi[0] = std::max(hi[0], in.x[i]);
-    lo[1] = std::min(lo[1], in.y[i]);
-    hi[1] = std::max(hi[1], in.y[i]);
+  float lo[3] = {in.x[0], in.y[0], in.z[0]};
+  float hi[3] = {lo[0], lo[1], lo[2]};
+  bool finite = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float x = in.x[i], y = in.y[i], z = in.z[i];
+    finite = finite && std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
+    lo[0] = std::min(lo[0], x);
+    hi[0] = std::max(hi[0], x);
+    lo[1] = std::min(lo[1], y);
+    hi[1] = std::max(hi[1], y);
+    lo[2] = std::min(lo[2], z);
+    hi[2] = std::max(hi[2], z);
   }
-  // With the adaptive radius, columns of 1.25 times the smallest radius: the radius passes the smallest at
-  // about 20 m and most far searches then still need only 3 x 3 columns (measured: 2 to 3 % of the
-  // pipeline's time saved on an HDL-32E field).
-  double edge = params_.tolerance_m * (adaptive_ ? 1.25 : 1.0);
-  const std::size_t max_cols = std::max(kMinCells, kCellsPerPoint * n);
+  const auto t = static_cast<float>(params_.tolerance_m);
+  float extent = 0.F;  // largest coordinate magnitude: sets the rounding the cell edge must leave room for
+  for (int k = 0; k < 3; ++k) extent = std::max({extent, std::fabs(lo[k]), std::fabs(hi[k])});
+  const float rounding = 8.F * extent * std::numeric_limits<float>::epsilon() + kSlack;
+  const float edge = (t * 0.999F - 2.F * rounding) / std::numbers::sqrt3_v<float>;
   std::size_t nx = 0, ny = 0;
-  for (;;) {
-    nx = static_cast<std::size_t>(static_cast<double>(hi[0] - lo[0]) / edge) + 1;
-    ny = static_cast<std::size_t>(static_cast<double>(hi[1] - lo[1]) / edge) + 1;
-    if (nx <= max_cols && ny <= max_cols && nx * ny <= max_cols) break;
-    edge *= 1.25;
+  if (finite && edge > 0.F) {
+    nx = static_cast<std::size_t>(static_cast<double>(hi[0] - lo[0]) / static_cast<double>(edge)) + 1;
+    ny = static_cast<std::size_t>(static_cast<double>(hi[1] - lo[1]) / static_cast<double>(edge)) + 1;
   }
-  const auto inv = static_cast<float>(1.0 / edge);
-  const auto e = static_cast<float>(edge);
-  // (Through int32: float to a 64-bit unsigned is a slow two-way conversion on x86-64; columns < 2^31.)
-  const auto cell = [inv](float v, float origin, std::size_t cells) {
-    float f = (v - origin) * inv;
-    f = f > 0.F ? f : 0.F;
-    f = f < 2.0e9F ? f : 2.0e9F;
-    const auto c = static_cast<std::size_t>(static_cast<std::int32_t>(f));
-    return c < cells ? c : cells - 1;
+  const std::size_t max_cols = std::max(kMinColumns, kColumnsPerPoint * n);
+  const double nz_d = finite && edge > 0.F ? static_cast<double>(hi[2] - lo[2]) / static_cast<double>(edge) : 0.0;
+  if (!finite || !(edge > 0.F) || nx > max_cols || ny > max_cols || nx * ny > max_cols ||
+      nz_d >= static_cast<double>(max_cols)) {
+    extract_kdtree(in, out);
+    return;
+  }
+  const float inv = 1.F / edge;
+  const auto cell = [inv](float v, float origin) {
+    return static_cast<std::uint32_t>(static_cast<std::int32_t>((v - origin) * inv));  // >= 0: v >= origin
   };
 
-  // Counting sort by column; afterwards col_start_[c] is where column c ends, so column c is
-  // [c == 0 ? 0 : col_start_[c - 1], col_start_[c]).
+  // Points sorted by x-y column and, within a column, by z cell: two stable counting sorts (by z cell, then
+  // by column), as an LSD radix sort.
   const std::size_t cols = nx * ny;
-  col_start_.assign(cols + 1, 0U);
-  cell_of_.resize(n);
+  const std::size_t nz = static_cast<std::size_t>(nz_d) + 1;
+  col_start_.assign(std::max(cols, nz) + 1, 0U);
+  cell_of_.resize(n);  // z cell of each point, then its column
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t c = cell(in.x[i], lo[0], nx) * ny + cell(in.y[i], lo[1], ny);
-    cell_of_[i] = static_cast<std::uint32_t>(c);
+    const std::uint32_t z = std::min<std::uint32_t>(cell(in.z[i], lo[2]), static_cast<std::uint32_t>(nz - 1));
+    cell_of_[i] = z;
+    ++col_start_[z + 1];
+  }
+  for (std::size_t z = 0; z < nz; ++z) col_start_[z + 1] += col_start_[z];
+  by_z_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    by_z_[col_start_[cell_of_[i]]++] = GridPoint{in.x[i], in.y[i], in.z[i], static_cast<std::uint32_t>(i), cell_of_[i]};
+  }
+  std::fill(col_start_.begin(), col_start_.begin() + static_cast<std::ptrdiff_t>(cols) + 1, 0U);
+  for (std::size_t k = 0; k < n; ++k) {
+    const GridPoint& g = by_z_[k];
+    const std::size_t c =
+        std::min<std::size_t>(cell(g.x, lo[0]), nx - 1) * ny + std::min<std::size_t>(cell(g.y, lo[1]), ny - 1);
+    cell_of_[k] = static_cast<std::uint32_t>(c);
     ++col_start_[c + 1];
   }
   for (std::size_t c = 0; c < cols; ++c) col_start_[c + 1] += col_start_[c];
   grid_points_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t p = col_start_[cell_of_[i]]++;
-    grid_points_[p] = GridPoint{in.x[i], in.y[i], in.z[i], static_cast<std::uint32_t>(i)};
+  col_next_.assign(col_start_.begin(), col_start_.begin() + static_cast<std::ptrdiff_t>(cols));
+  for (std::size_t k = 0; k < n; ++k) grid_points_[col_next_[cell_of_[k]]++] = by_z_[k];
+  // Cells: runs of one z cell in a column.
+  cells_.clear();
+  col_cells_.resize(cols + 1);
+  GridPoint* gp = grid_points_.data();
+  for (std::size_t c = 0; c < cols; ++c) {
+    col_cells_[c] = static_cast<std::uint32_t>(cells_.size());
+    const std::uint32_t b = col_start_[c], e = col_start_[c + 1];
+    for (std::uint32_t j = b; j < e; ++j) {
+      if (j == b || gp[j].iz != gp[j - 1].iz) cells_.push_back(Cell{j, static_cast<std::uint32_t>(c), gp[j].iz, 0.F});
+    }
   }
-  const auto col_begin = [this](std::size_t c) { return c == 0 ? 0U : col_start_[c - 1]; };
-  // Each column keeps the points not yet in a cluster behind a moving boundary: a point that joins a cluster
-  // is swapped in front of it. A search then scans only points still free: an object that one cluster has
-  // swallowed costs no more searching, however dense (a shed's wall). (Sorting the columns by height to search
-  // only the slab within the radius measured slower: a column of a voxelised cloud holds a few dozen points.)
-  col_next_.resize(cols);
-  for (std::size_t c = 0; c < cols; ++c) col_next_[c] = col_begin(c);
-  if (adaptive_) sorted_r2_.resize(n);
-  for (std::size_t p = 0; p < n; ++p) {
-    const GridPoint& g = grid_points_[p];
-    pos_of_[g.index] = static_cast<std::uint32_t>(p);
-    if (adaptive_) sorted_r2_[p] = r2_[g.index];
+  col_cells_[cols] = static_cast<std::uint32_t>(cells_.size());
+  const auto ncells = static_cast<std::uint32_t>(cells_.size());
+  cells_.push_back(Cell{static_cast<std::uint32_t>(n), 0, 0, 0.F});  // sentinel: the end of the last cell
+  sorted_r2_.resize(n);
+  parent_.resize(ncells);
+  for (std::uint32_t c = 0; c < ncells; ++c) {
+    parent_[c] = c;
+    float m = base_r2_;
+    for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) {
+      const float r2 = adaptive_ ? r2_[gp[j].index] : base_r2_;
+      sorted_r2_[j] = r2;
+      m = std::max(m, r2);
+    }
+    cells_[c].reach2 = m;
   }
 
-  GridPoint* gp = grid_points_.data();
-  float* r2 = adaptive_ ? sorted_r2_.data() : nullptr;
-  // Takes the free point at position j of column c into the cluster: to the members, and behind the boundary.
-  const auto take = [&](std::uint32_t j, std::size_t c) {
-    const std::uint32_t t = col_next_[c]++;
-    const GridPoint g = gp[j];
-    members_.push_back(Member{g.x, g.y, g.z, g.index, adaptive_ ? r2[j] : base_r2_});
-    done_[g.index] = 1U;
-    if (t != j) {
-      gp[j] = gp[t];
-      gp[t] = g;
-      pos_of_[gp[j].index] = j;
-      pos_of_[g.index] = t;
-      if (adaptive_) std::swap(r2[j], r2[t]);
-    }
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    if (done_[i] != 0U) continue;
-    members_.clear();
-    take(pos_of_[i], cell_of_[i]);
-    for (std::size_t qi = 0; qi < members_.size(); ++qi) {
-      const Member p = members_[qi];
-      std::size_t k = 1;
-      float q2 = base_r2_;
-      if (adaptive_) {
-        const float q = query_[p.index];
-        q2 = q * q;
-        k = static_cast<std::size_t>(q / e) + 1;  // at least ceil(q / e); a column more is skipped below
-      }
-      const std::size_t cx = cell(p.x, lo[0], nx), cy = cell(p.y, lo[1], ny);
-      const std::size_t x0 = cx >= k ? cx - k : 0, x1 = std::min(cx + k, nx - 1);
-      const std::size_t y0 = cy >= k ? cy - k : 0, y1 = std::min(cy + k, ny - 1);
-      // Columns of the block whose nearest side is beyond the radius (the corners, when k > 1) are skipped.
-      const float px = p.x - lo[0], py = p.y - lo[1];
-      for (std::size_t x = x0; x <= x1; ++x) {
-        const float fx = static_cast<float>(x) * e;
-        const float gx = std::max(0.F, std::max(fx - px, px - (fx + e)));
-        for (std::size_t y = y0; y <= y1; ++y) {
-          const std::size_t c = x * ny + y;
-          const std::uint32_t ce = col_start_[c];
-          if (col_next_[c] == ce) continue;  // nothing free here
-          if (k > 1) {
-            const float fy = static_cast<float>(y) * e;
-            const float gy = std::max(0.F, std::max(fy - py, py - (fy + e)));
-            if (!(gx * gx + gy * gy < q2)) continue;
+  // Joins. From each cell, the cells within its own reach (its points' search radius): of two points, the
+  // one with the larger radius reaches the other, so every joining pair is tested from at least one side.
+  std::uint32_t* parent = parent_.data();
+  const float* r2 = sorted_r2_.data();
+  for (std::uint32_t a = 0; a < ncells; ++a) {
+    const Cell& ca = cells_[a];
+    const std::uint32_t a0 = ca.first, a1 = cells_[a + 1].first;
+    const float reach2 = ca.reach2;
+    const auto reach = static_cast<std::int64_t>(std::sqrt(reach2) / edge) + 1;
+    const auto ax = static_cast<std::int64_t>(ca.col / ny), ay = static_cast<std::int64_t>(ca.col % ny);
+    const auto az = static_cast<std::int64_t>(ca.iz);
+    std::uint32_t ra = find_root(parent, a);  // kept up to date: only this loop joins a's root to another
+    const auto gap = [edge](std::int64_t d) {
+      const std::int64_t g = d < 0 ? -d - 1 : d - 1;
+      return g > 0 ? static_cast<float>(g) * edge - kSlack : 0.F;
+    };
+    for (std::int64_t x = std::max<std::int64_t>(0, ax - reach);
+         x <= std::min<std::int64_t>(ax + reach, static_cast<std::int64_t>(nx) - 1); ++x) {
+      const float gx = gap(x - ax);
+      for (std::int64_t y = std::max<std::int64_t>(0, ay - reach);
+           y <= std::min<std::int64_t>(ay + reach, static_cast<std::int64_t>(ny) - 1); ++y) {
+        const float gy = gap(y - ay);
+        const float gxy = gx * gx + gy * gy;
+        if (!(gxy < reach2)) continue;
+        const auto col = static_cast<std::size_t>(x) * ny + static_cast<std::size_t>(y);
+        for (std::uint32_t b = col_cells_[col]; b < col_cells_[col + 1]; ++b) {
+          const Cell& cb = cells_[b];
+          if (b == a) continue;
+          const std::int64_t dz = static_cast<std::int64_t>(cb.iz) - az;
+          if (dz > reach) break;  // cells of a column ascend in z
+          if (dz < -reach) continue;
+          const float gz = gap(dz);
+          if (!(gxy + gz * gz < reach2)) continue;
+          const std::uint32_t rb = find_root(parent, b);
+          if (ra == rb) continue;
+          const std::uint32_t b0 = cb.first, b1 = cells_[b + 1].first;
+          bool joined = false;
+          for (std::uint32_t i = a0; i < a1 && !joined; ++i) {
+            const GridPoint p = gp[i];
+            for (std::uint32_t j = b0; j < b1; ++j) {
+              const float dx = gp[j].x - p.x, dy = gp[j].y - p.y, dz2 = gp[j].z - p.z;
+              const float d2 = dx * dx + dy * dy + dz2 * dz2;
+              if (d2 < std::max(r2[i], r2[j])) {
+                joined = true;
+                break;
+              }
+            }
           }
-          for (std::uint32_t j = col_next_[c]; j < ce; ++j) {
-            const float dx = gp[j].x - p.x, dy = gp[j].y - p.y, dz = gp[j].z - p.z;
-            const float d2 = dx * dx + dy * dy + dz * dz;
-            if (!(d2 < q2)) continue;
-            if (adaptive_ && !(d2 < std::max(p.r2, r2[j]))) continue;
-            take(j, c);  // the point swapped into j was scanned already: go on after it
+          if (joined) {
+            parent[std::max(ra, rb)] = std::min(ra, rb);
+            ra = std::min(ra, rb);
           }
         }
       }
     }
-    queue_.clear();
-    for (const Member& mb : members_) queue_.push_back(mb.index);
-    finish_cluster(out);
   }
+
+  // Clusters in the order of their lowest point index, members ascending: one pass in index order.
+  cluster_of_root_.assign(ncells, kNoCluster);
+  pos_of_.resize(n);  // cell of each point
+  for (std::uint32_t c = 0; c < ncells; ++c) {
+    for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) pos_of_[gp[j].index] = c;
+  }
+  std::uint32_t clusters = 0;
+  col_next_.clear();  // reused: the size of each cluster
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t root = find_root(parent, pos_of_[i]);
+    std::uint32_t& id = cluster_of_root_[root];
+    if (id == kNoCluster) {
+      id = clusters++;
+      col_next_.push_back(0U);
+    }
+    ++col_next_[id];
+    cell_of_[i] = id;
+  }
+  out.offsets.resize(clusters + 1);
+  out.offsets[0] = 0;
+  for (std::uint32_t c = 0; c < clusters; ++c) out.offsets[c + 1] = out.offsets[c] + col_next_[c];
+  out.indices.resize(n);
+  for (std::uint32_t c = 0; c < clusters; ++c) col_next_[c] = out.offsets[c];
+  for (std::size_t i = 0; i < n; ++i) out.indices[col_next_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
 }
 
 }  // namespace fieldguard::perception

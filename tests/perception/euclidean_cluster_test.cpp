@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <tuple>
@@ -202,6 +203,84 @@ TEST(EuclideanClusterer, GridWithEnlargedCellsStaysExact) {
   kd.extract(c, a);
   grid.extract(c, b);
   EXPECT_EQ(sets_of(a), sets_of(b));
+}
+
+// The grid's cells are a piece of one cluster each, and neighbouring cells join through their nearest pair: a
+// lattice just under the radius is one cluster, just over it all singletons (no pair within a cell is ever
+// that far apart, so only the cross-cell tests decide), with either structure.
+TEST(EuclideanClusterer, LatticeJustUnderAndOverTheRadius) {
+  for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+    EuclideanClusterer clusterer(params(ClusterMethod::Fixed, structure));
+    Clusters out;
+    for (const float step : {0.59F, 0.61F}) {
+      Cloud c;
+      testing::add_block(c, {3.0F, -2.0F, -1.0F}, {8, 7, 5}, step);  // 280 points
+      clusterer.extract(c, out);
+      EXPECT_EQ(out.size(), step < 0.6F ? 1U : 280U) << step << (structure == ClusterStructure::Grid ? " grid" : " kd");
+    }
+  }
+}
+
+// Pairs of points in every direction, 0.59 m apart (one cluster each) and 0.61 m apart (two), spread over many
+// cell offsets: two points far enough apart never share a grid cell, and near enough ones in two cells join.
+TEST(EuclideanClusterer, PairsJustInsideAndOutsideTheRadius) {
+  testing::TestRng rng{5};
+  for (const float d : {0.59F, 0.61F}) {
+    Cloud c;
+    for (int i = 0; i < 300; ++i) {
+      float u[3] = {rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
+      const float len = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+      if (len < 0.1F) continue;
+      const float x = 2.F + 3.F * static_cast<float>(i % 15) + rng.uniform(0, 1);
+      const float y = -9.F + 3.F * static_cast<float>(i / 15) + rng.uniform(0, 1);
+      const float z = rng.uniform(-1, 1);
+      c.push_back(x, y, z);
+      c.push_back(x + d * u[0] / len, y + d * u[1] / len, z + d * u[2] / len);
+    }
+    for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+      EuclideanClusterer clusterer(params(ClusterMethod::Fixed, structure));
+      Clusters out;
+      clusterer.extract(c, out);
+      EXPECT_EQ(out.size(), d < 0.6F ? c.size() / 2 : c.size())
+          << d << (structure == ClusterStructure::Grid ? " grid" : " kd");
+    }
+  }
+}
+
+// A shed's walls after the voxel grid: two dense 0.15 m lattices (4 m long, 3 m high) whose facing sides are
+// 0.55 m apart are one cluster, 0.65 m apart two; the grid agrees with the k-d tree point for point.
+TEST(EuclideanClusterer, DenseWallsJoinOrStayApart) {
+  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive}) {
+    for (const float gap : {0.55F, 0.65F}) {
+      Cloud c;
+      testing::add_block(c, {6.0F, -2.0F, -1.0F}, {2, 27, 20}, 0.15F);         // x 6.00 .. 6.15
+      testing::add_block(c, {6.15F + gap, -2.0F, -1.0F}, {2, 27, 20}, 0.15F);  // the facing wall
+      Clusters a, b;
+      EuclideanClusterer kd(params(method, ClusterStructure::KdTree));
+      EuclideanClusterer grid(params(method, ClusterStructure::Grid));
+      kd.extract(c, a);
+      grid.extract(c, b);
+      EXPECT_EQ(b.size(), gap < 0.6F ? 1U : 2U) << gap;
+      EXPECT_EQ(sets_of(a), sets_of(b)) << gap;
+    }
+  }
+}
+
+// A point that is not finite cannot be put in a cell: the grid then clusters over the k-d tree, where a NaN is
+// near nothing (a singleton), and the finite points cluster as ever.
+TEST(EuclideanClusterer, GridWithNonFinitePointsMatchesTheKdTree) {
+  Cloud c = two_boxes(0.5F);
+  c.push_back(std::numeric_limits<float>::quiet_NaN(), 0.F, 0.F);
+  c.push_back(5.2F, 0.2F, 0.2F);
+  Clusters a, b;
+  EuclideanClusterer kd(params(ClusterMethod::Fixed, ClusterStructure::KdTree));
+  EuclideanClusterer grid(params(ClusterMethod::Fixed, ClusterStructure::Grid));
+  kd.extract(c, a);
+  grid.extract(c, b);
+  EXPECT_EQ(sets_of(a), sets_of(b));
+  ASSERT_EQ(b.size(), 2U);
+  EXPECT_EQ(b[1].size(), 1U);  // the NaN
+  EXPECT_EQ(b[1][0], 432U);
 }
 
 TEST(EuclideanClusterer, RefusesImpossibleRadii) {

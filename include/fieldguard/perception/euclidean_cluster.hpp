@@ -6,8 +6,8 @@
 // Fixed: one radius (d^2 < r^2 in float, as pcl::search::KdTree). Adaptive: each point has its radius from its
 // 3D range (ClusterParams); two points join when nearer than the larger of their two radii, which is
 // symmetric, so the clusters do not depend on the search order. Structures: KdTree (our k-d tree, the
-// published way) or Grid (points counting-sorted into x-y columns of the smallest radius; a search scans the
-// points of the neighbouring columns not yet in a cluster). Both find exactly the same clusters.
+// published way) or Grid (cubic cells small enough that a cell's points always join; union-find over cells,
+// neighbouring cells joined by their first pair within reach). Both find exactly the same clusters.
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
 
@@ -66,16 +66,23 @@ class EuclideanClusterer {
   struct GridPoint {
     float x, y, z;
     std::uint32_t index;
+    std::uint32_t iz;  // z cell
   };
+  struct Cell {
+    std::uint32_t first;  // its points: grid_points_[first, next cell's first)
+    std::uint32_t col;    // x-y column
+    std::uint32_t iz;     // z cell
+    float reach2;         // the largest radius of its points, squared
+  };
+  static constexpr std::uint32_t kNoCluster = 0xFFFFFFFFU;
   Buffer<GridPoint> grid_points_;
+  Buffer<GridPoint> by_z_;          // the points sorted by z cell (the first radix pass)
   Buffer<float> sorted_r2_;         // r2_ in grid order
-  Buffer<std::uint32_t> col_next_;  // per column: its first point not yet in a cluster
-  struct Member {                   // a point taken into the cluster being grown
-    float x, y, z;
-    std::uint32_t index;
-    float r2;
-  };
-  Buffer<Member> members_;
+  Buffer<std::uint32_t> col_next_;  // scratch: per column, then per cluster
+  Buffer<Cell> cells_;
+  Buffer<std::uint32_t> col_cells_;  // per column: its first cell (cells of a column ascend in z)
+  Buffer<std::uint32_t> parent_;     // union-find over cells
+  Buffer<std::uint32_t> cluster_of_root_;
   Buffer<std::uint8_t> mark_;
 };
 
