@@ -11,6 +11,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "app/config_output.hpp"
+#include "app/config_safety.hpp"
 #include "app/config_sensors.hpp"
 #include "app/yaml_reader.hpp"
 
@@ -313,12 +315,15 @@ LoadResult load(const std::string& text, const std::string& name, const std::str
     result.issues.push_back({name, 0, "", "the file is empty; start from config/fieldguard.yaml"});
     return result;
   }
-  if (r.section(root, "", {"lidar", "scan2d", "gnss", "ahrs", "perception"})) {
+  if (r.section(root, "", {"lidar", "scan2d", "gnss", "ahrs", "perception", "safety", "pipeline", "can"})) {
     read_lidar(r, root["lidar"], config_dir, result.config.lidar);
     read_scan2d(r, root["scan2d"], result.config.scan2d);
     read_gnss(r, root["gnss"], result.config.gnss);
     read_ahrs(r, root["ahrs"], result.config.ahrs);
     read_perception(r, root["perception"], result.config.perception);
+    read_safety(r, root["safety"], result.config);
+    read_pipeline(r, root["pipeline"], result.config.pipeline);
+    read_can(r, root["can"], config_dir, result.config.can);
     // The zone ground starts from the ground below the sensor: the LiDAR's mounting height when the file
     // gives one (otherwise ZoneParams' default, 0.95 m).
     auto& cfg = result.config;

@@ -3,16 +3,20 @@
 #include <unistd.h>
 
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
-#include <fstream>
-
 #include "app/args.hpp"
 #include "app/bev.hpp"
+#include "app/can_stage.hpp"
 #include "app/commands.hpp"
 #include "app/logging.hpp"
 #include "app/obstacles_jsonl.hpp"
@@ -25,6 +29,8 @@
 #include "fieldguard/drivers/velodyne_position.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/pcap_reader.hpp"
+#include "fieldguard/output/can_sink.hpp"
+#include "fieldguard/sync/ordered_pool.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -33,7 +39,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kHelp =
     "usage: fieldguard replay --config FILE (--pcap FILE | --session DIR) [--obstacles-out FILE] [--bev-dir DIR]\n"
-    "                         [--pcd-dir DIR] [--samples-out FILE] [--quiet]\n"
+    "                         [--pcd-dir DIR] [--samples-out FILE] [--can-log FILE] [--workers N] [--quiet]\n"
     "\n"
     "Runs a capture of Velodyne packets (classic pcap or pcapng; Ethernet, VLAN, Linux cooked SLL/SLL2 or raw\n"
     "IPv4) through the decoder and cuts it into rotations.\n"
@@ -55,6 +61,16 @@ constexpr const char* kHelp =
     "  --pcd-dir DIR   write one binary PCD per rotation: frame_NNNNNN.pcd, and frame_NNNNNN_partial.pcd for\n"
     "                  the first and last rotations when they are not a full turn (fields x y z intensity ring\n"
     "                  time; sensor frame x forward, y left, z up, metres; time in s after the rotation start)\n"
+    "  --can-log FILE  run the detection pipeline and the safety monitor (`safety:`) and write every CAN frame\n"
+    "                  the daemon would have sent (`can:` addresses, DBC config/fieldguard.dbc) as a candump -L\n"
+    "                  log stamped with capture time: heartbeats and the stop request every\n"
+    "                  can.heartbeat_period_s from the first packet (STOP, starting up, until the first rotation\n"
+    "                  is decided), and per rotation, when its last packet is in, the obstacle summary, the\n"
+    "                  obstacles and the stop request. Sensors other than the 3D LiDAR count as never heard\n"
+    "  --workers N     run the detection pipeline on N worker threads (1..64; default: pipeline.workers of the\n"
+    "                  configuration, 1 without it). Every output is written in rotation order on the main\n"
+    "                  thread and is byte-identical for any N; no rotation is ever dropped (the reader waits\n"
+    "                  for the workers when they fall behind)\n"
     "  --quiet         no progress line\n"
     "\n"
     "Ends with a summary: packets read, decoded, dropped by reason, rotations, points, wall time.\n"
@@ -171,11 +187,72 @@ bool replay_logs(const std::vector<LogFile>& logs, SampleDecoder& samples) {
   return true;
 }
 
+// A rotation on its way through the worker pool, with the capture time at which replay held all of it (the
+// packet that closed it, or the end of the capture): when the daemon would have decided on it.
+struct Job {
+  LidarFrame frame;
+  Stamp complete;
+};
+
+struct Processed {
+  perception::FrameResult result;
+  std::optional<Image> bev;  // rendered by the worker: it needs that worker's Pipeline::last_points()
+};
+
+using Pool = sync::OrderedPool<Job, Processed>;
+
+// A Pipeline keeps scratch buffers between frames and is not thread-safe, so each worker borrows one for the
+// length of a rotation. There are as many as workers: a worker never finds the set empty.
+class PipelineSet {
+ public:
+  PipelineSet(const perception::PipelineParams& params, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) free_.push_back(std::make_unique<perception::Pipeline>(params));
+  }
+  class Lease {
+   public:
+    explicit Lease(PipelineSet& set) : set_(set) {
+      const std::lock_guard lock(set_.mutex_);
+      if (set_.free_.empty()) throw std::logic_error("more workers than pipelines");
+      p_ = std::move(set_.free_.back());
+      set_.free_.pop_back();
+    }
+    ~Lease() {
+      const std::lock_guard lock(set_.mutex_);
+      set_.free_.push_back(std::move(p_));
+    }
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    Lease(Lease&&) = delete;
+    Lease& operator=(Lease&&) = delete;
+    perception::Pipeline& operator*() const { return *p_; }
+    perception::Pipeline* operator->() const { return p_.get(); }
+
+   private:
+    PipelineSet& set_;
+    std::unique_ptr<perception::Pipeline> p_;
+  };
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<perception::Pipeline>> free_;
+};
+
+// --workers: 1..64 (sync::PoolParams' limits). Empty optional and a message when it is not.
+std::optional<std::size_t> parse_workers(const std::string& text, std::string& error) {
+  unsigned long long n = 0;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || ptr != text.data() + text.size() || n < 1 || n > 64) {
+    error = "--workers takes a whole number of worker threads from 1 to 64, got '" + text + "'";
+    return std::nullopt;
+  }
+  return static_cast<std::size_t>(n);
+}
+
 }  // namespace
 
 int cmd_replay(const std::vector<std::string>& argv) {
   const Args args(argv, {"config", "pcap", "session", "scan2d-log", "gnss-log", "ahrs-log", "pcd-dir", "bev-dir",
-                         "obstacles-out", "samples-out"},
+                         "obstacles-out", "samples-out", "workers", "can-log"},
                   {"help", "quiet"});
   if (args.has("help")) {
     std::fputs(kHelp, stdout);
@@ -199,6 +276,16 @@ int cmd_replay(const std::vector<std::string>& argv) {
     return kExitBadInput;
   }
   const Config& cfg = loaded.config;
+  std::size_t workers = static_cast<std::size_t>(cfg.pipeline.workers);
+  if (auto w = args.get("workers")) {
+    std::string err;
+    const auto n = parse_workers(*w, err);
+    if (!n) {
+      std::fprintf(stderr, "fieldguard replay: %s\n", err.c_str());
+      return kExitBadInput;
+    }
+    workers = *n;
+  }
 
   const std::string session_dir = args.get("session").value_or("");
   if (!session_dir.empty() && !fs::is_directory(session_dir)) {
@@ -254,9 +341,23 @@ int cmd_replay(const std::vector<std::string>& argv) {
       return kExitBadInput;
     }
   }
-  const bool detect = obstacles_out.is_open() || !bev_dir.empty();
-  std::optional<perception::Pipeline> pipeline;
-  if (detect) pipeline.emplace(cfg.perception);
+  std::optional<output::CandumpLogSink> can_log;
+  std::optional<CanStage> can;
+  if (auto c = args.get("can-log")) {
+    try {
+      can_log.emplace(*c, cfg.can.interface);
+      can.emplace(cfg, *can_log);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "fieldguard replay: --can-log: %s\n", e.what());
+      return kExitBadInput;
+    }
+  }
+  auto can_log_error = [&] {
+    return "cannot write " + *args.get("can-log") + ": " + std::strerror(can_log->stats().last_errno);
+  };
+  const bool detect = obstacles_out.is_open() || !bev_dir.empty() || can.has_value();
+  std::optional<PipelineSet> pipelines;
+  if (detect) pipelines.emplace(cfg.perception, workers);
   std::uint64_t obstacles_total = 0;
 
   velodyne::Stream stream(velodyne_stream_options(cfg.lidar));
@@ -265,40 +366,80 @@ int cmd_replay(const std::vector<std::string>& argv) {
   PortCounters ports;
   std::vector<LidarFrame> frames;
   std::uint64_t written = 0;
+  std::uint64_t lost = 0;
   std::string write_error;
   Stamp first_time;
   Stamp last_time;
   const bool progress = !args.has("quiet") && isatty(STDERR_FILENO) != 0;
   auto last_progress = started;
 
-  auto handle_frames = [&]() {
-    for (const auto& f : frames) {
-      if (!write_error.empty()) break;
-      char stem[64];
-      std::snprintf(stem, sizeof stem, "frame_%06llu%s", static_cast<unsigned long long>(f.index),
-                    f.partial ? "_partial" : "");
-      if (!pcd_dir.empty()) {
-        write_error = write_pcd((fs::path(pcd_dir) / (std::string(stem) + ".pcd")).string(), f);
-        if (write_error.empty()) ++written;
+  // Workers: perception (and the bird's-eye picture, which needs the worker's pipeline). Everything that is
+  // written happens in deliver(), on this thread, in rotation order: the output does not depend on the count.
+  auto process = [&](Job& job) {
+    Processed out;
+    if (!pipelines) return out;
+    const PipelineSet::Lease pipeline(*pipelines);
+    out.result = pipeline->process(job.frame.points);
+    if (!bev_dir.empty()) out.bev = render_bev(pipeline->last_points(), out.result, cfg.perception, std::nullopt);
+    return out;
+  };
+  auto deliver = [&](const Pool::Result& r) {
+    const LidarFrame& f = r.input->frame;
+    if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
+      // Replay uses the non-dropping submit, so this is a failed pipeline run; it is reported, never skipped.
+      ++lost;
+      if (write_error.empty()) {
+        write_error = "rotation " + std::to_string(f.index) + " was not processed (" + sync::to_string(r.outcome) +
+                      (r.error != nullptr ? ": " + *r.error : std::string()) + ")";
       }
-      if (!pipeline) continue;
-      const perception::FrameResult result = pipeline->process(f.points);
-      obstacles_total += result.obstacles.size();
-      if (obstacles_out.is_open()) {
-        obstacles_out << obstacles_json_line(f, result) << '\n';
-        if (!obstacles_out) write_error = "cannot write " + *args.get("obstacles-out");
-      }
-      if (!bev_dir.empty() && write_error.empty()) {
-        write_error = write_png((fs::path(bev_dir) / (std::string(stem) + ".png")).string(),
-                                render_bev(pipeline->last_points(), result, cfg.perception, std::nullopt));
-      }
+      return;
+    }
+    if (!write_error.empty()) return;
+    char stem[64];
+    std::snprintf(stem, sizeof stem, "frame_%06llu%s", static_cast<unsigned long long>(f.index),
+                  f.partial ? "_partial" : "");
+    if (!pcd_dir.empty()) {
+      write_error = write_pcd((fs::path(pcd_dir) / (std::string(stem) + ".pcd")).string(), f);
+      if (write_error.empty()) ++written;
+    }
+    if (!pipelines) return;
+    const perception::FrameResult& result = r.output->result;
+    obstacles_total += result.obstacles.size();
+    if (obstacles_out.is_open() && write_error.empty()) {
+      obstacles_out << obstacles_json_line(f, result) << '\n';
+      if (!obstacles_out) write_error = "cannot write " + *args.get("obstacles-out");
+    }
+    if (r.output->bev && write_error.empty()) {
+      write_error = write_png((fs::path(bev_dir) / (std::string(stem) + ".png")).string(), *r.output->bev);
+    }
+    if (can) {
+      can->frame(f, result, r.input->complete, lost);
+      if (can_log->stats().write_errors != 0 && write_error.empty()) write_error = can_log_error();
+    }
+  };
+  sync::PoolParams pool_params;
+  pool_params.workers = workers;
+  pool_params.queue_capacity = static_cast<std::size_t>(cfg.pipeline.queue_capacity);
+  Pool pool(pool_params, process);
+  Job job;
+  auto handle_frames = [&](Stamp complete) {
+    for (auto& f : frames) {
+      using std::swap;
+      swap(job.frame, f);
+      job.complete = complete;
+      // Back-pressure instead of a drop: replay must lose no rotation, so a full queue waits for results.
+      while (!pool.try_submit(job)) pool.poll_wait(deliver);
+      pool.poll(deliver);
     }
     frames.clear();
   };
 
   while (auto dg = reader->next()) {
     if (samples) samples->lidar(*dg);
-    if (first_time.ns == 0) first_time = dg->host_time;
+    if (first_time.ns == 0) {
+      first_time = dg->host_time;
+      if (can) can->start(first_time);
+    }
     last_time = dg->host_time;
     if (dg->dst_port == cfg.lidar.data_port) {
       if (dg->payload.size() != velodyne::kDataPacketSize) {
@@ -306,7 +447,7 @@ int cmd_replay(const std::vector<std::string>& argv) {
         continue;
       }
       stream.push(dg->payload, dg->host_time, frames);
-      handle_frames();
+      handle_frames(dg->host_time);
     } else if (dg->dst_port == cfg.lidar.position_port) {
       ++pos.packets;
       auto p = velodyne::decode_position_packet(dg->payload);
@@ -331,13 +472,27 @@ int cmd_replay(const std::vector<std::string>& argv) {
     }
   }
   stream.finish(frames);
-  handle_frames();
+  handle_frames(last_time);
+  pool.stop(sync::Drain::Yes);
+  while (pool.outstanding() > 0 && pool.poll(deliver) > 0) {
+  }
+  if (can) {
+    can->tick(last_time, lost);
+    if (can_log->stats().write_errors != 0 && write_error.empty()) write_error = can_log_error();
+  }
   if (progress) std::fprintf(stderr, "\r%60s\r", "");
 
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   print_summary(pcap_path, reader->stats(), stream, pos, ports, written, wall_s,
                 static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
-  if (pipeline) std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+  if (pipelines) std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+  std::printf("  workers           %zu, %llu rotations lost\n", workers, static_cast<unsigned long long>(lost));
+  if (can) {
+    const auto& cc = can->counts();
+    std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", static_cast<unsigned long long>(cc.stop_frames),
+                static_cast<unsigned long long>(cc.go_frames), static_cast<unsigned long long>(cc.changes));
+    std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log->stats().sent));
+  }
   if (!logs.empty() && !replay_logs(logs, *samples)) return kExitBadInput;
   if (samples) samples->finish();
 

@@ -6,9 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "fieldguard/app/config_output.hpp"
 #include "fieldguard/core/mounting.hpp"
 #include "fieldguard/drivers/velodyne_calibration.hpp"
 #include "fieldguard/drivers/velodyne_decoder.hpp"
+#include "fieldguard/output/safety_params.hpp"
 #include "fieldguard/perception/params.hpp"
 
 namespace fieldguard::app {
@@ -71,6 +73,9 @@ struct Config {
   GnssConfig gnss;
   AhrsConfig ahrs;
   perception::PipelineParams perception;
+  output::safety::Params safety;  // the stop decision
+  PipelineConfig pipeline;        // the perception worker pool
+  CanConfig can;                  // the CAN output
 };
 
 // One problem found in a configuration file.

@@ -1,0 +1,31 @@
+#pragma once
+// The configuration of the pipeline's worker pool (`pipeline:`) and of the CAN output (`can:`): plain values
+// with defaults, filled and checked by the config loader (src/app/config_pipeline.cpp, config_can.cpp).
+
+#include <cstdint>
+#include <string>
+
+#include "fieldguard/output/can_encoder.hpp"
+
+namespace fieldguard::app {
+
+enum class PipelineDrop : std::uint8_t { Oldest, Newest };
+
+// The lock-free hand-off from the io thread to the perception workers (sync::OrderedPool).
+struct PipelineConfig {
+  int workers = 1;          // perception threads, 1..64
+  int queue_capacity = 8;   // rotations waiting for a worker, 1..4096
+  PipelineDrop drop = PipelineDrop::Oldest;  // live, a full queue drops (and counts) this one; replay never drops
+};
+
+enum class CanSinkKind : std::uint8_t { SocketCan, Candump, None };
+
+struct CanConfig {
+  CanSinkKind sink = CanSinkKind::SocketCan;
+  std::string interface = "can0";   // the SocketCAN interface; also the interface name written in a candump log
+  std::string log_path;             // sink candump: the log file (relative paths from the config file's folder)
+  output::CanParams params;         // source and controller addresses, obstacle messages per frame
+  double heartbeat_period_s = 0.1;  // heartbeat (and repeated stop request) period
+};
+
+}  // namespace fieldguard::app

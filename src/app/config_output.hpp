@@ -1,0 +1,17 @@
+#pragma once
+// Readers of the `pipeline:` and `can:` sections. Private to the app.
+
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+
+#include "app/yaml_reader.hpp"
+#include "fieldguard/app/config.hpp"
+
+namespace fieldguard::app {
+
+void read_pipeline(YamlReader& r, const YAML::Node& n, PipelineConfig& c);
+// `config_dir`: the config file's folder, against which a relative log path is taken ("" for text).
+void read_can(YamlReader& r, const YAML::Node& n, const std::string& config_dir, CanConfig& c);
+
+}  // namespace fieldguard::app

@@ -1,0 +1,109 @@
+// The `pipeline:` and `can:` sections of the configuration.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "fieldguard/app/config.hpp"
+
+namespace fieldguard::app {
+namespace {
+
+bool has_issue(const LoadResult& r, const std::string& key, const std::string& words, int line) {
+  return std::any_of(r.issues.begin(), r.issues.end(), [&](const ConfigIssue& i) {
+    return i.key_path == key && i.message.find(words) != std::string::npos && i.line == line;
+  });
+}
+
+std::string dump(const LoadResult& r) {
+  std::string s;
+  for (const auto& i : r.issues) s += i.to_string() + "\n";
+  return s;
+}
+
+TEST(ConfigOutput, DefaultsWithoutTheSections) {
+  const auto r = load_config_text("lidar: {model: auto}\n", "d.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  EXPECT_EQ(r.config.pipeline.workers, 1);
+  EXPECT_EQ(r.config.pipeline.queue_capacity, 8);
+  EXPECT_EQ(r.config.pipeline.drop, PipelineDrop::Oldest);
+  EXPECT_EQ(r.config.can.sink, CanSinkKind::SocketCan);
+  EXPECT_EQ(r.config.can.interface, "can0");
+  EXPECT_EQ(r.config.can.params.source_address, 0x80);
+  EXPECT_EQ(r.config.can.params.controller_address, 0x26);
+  EXPECT_EQ(r.config.can.params.max_obstacles, 8);
+  EXPECT_DOUBLE_EQ(r.config.can.heartbeat_period_s, 0.1);
+}
+
+TEST(ConfigOutput, ReadsEveryKey) {
+  const auto r = load_config_text(R"(
+pipeline: {workers: 4, queue_capacity: 32, drop: newest}
+can:
+  sink: candump
+  interface: vcan1
+  log_path: /var/lib/fieldguard/can.log
+  source_address: 0xA0
+  controller_address: 19
+  max_obstacles: 16
+  heartbeat_period_s: 0.05
+)",
+                                  "o.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  EXPECT_EQ(r.config.pipeline.workers, 4);
+  EXPECT_EQ(r.config.pipeline.queue_capacity, 32);
+  EXPECT_EQ(r.config.pipeline.drop, PipelineDrop::Newest);
+  EXPECT_EQ(r.config.can.sink, CanSinkKind::Candump);
+  EXPECT_EQ(r.config.can.interface, "vcan1");
+  EXPECT_EQ(r.config.can.log_path, "/var/lib/fieldguard/can.log");
+  EXPECT_EQ(r.config.can.params.source_address, 0xA0);
+  EXPECT_EQ(r.config.can.params.controller_address, 19);
+  EXPECT_EQ(r.config.can.params.max_obstacles, 16);
+  EXPECT_DOUBLE_EQ(r.config.can.heartbeat_period_s, 0.05);
+  EXPECT_EQ(load_config_text("can: {sink: none}\n", "n.yaml").config.can.sink, CanSinkKind::None);
+}
+
+TEST(ConfigOutput, ReportsEveryProblemWithLineAndKey) {
+  const auto r = load_config_text(R"(pipeline:
+  workers: 0
+  queue_capacity: 5000
+  drop: middle
+  threads: 2
+can:
+  sink: serial
+  interface: "can 0"
+  source_address: 0xFE
+  controller_address: 0x1G
+  max_obstacles: 17
+  heartbeat_period_s: 5
+)",
+                                  "bad.yaml");
+  EXPECT_TRUE(has_issue(r, "pipeline.workers", "out of range", 2)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "pipeline.queue_capacity", "out of range", 3)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "pipeline.drop", "not one of oldest, newest", 4)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "pipeline.threads", "", 5)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.sink", "not one of socketcan, candump, none", 7)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.interface", "", 8)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.source_address", "null and global", 9)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.controller_address", "expected a J1939 address", 10)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.max_obstacles", "out of range", 11)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.heartbeat_period_s", "out of range", 12)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 10U) << dump(r);
+}
+
+TEST(ConfigOutput, CandumpNeedsALogAndAddressesMustDiffer) {
+  const auto r = load_config_text(R"(can:
+  sink: candump
+  source_address: 0x26
+  controller_address: 38
+)",
+                                  "c.yaml");
+  EXPECT_TRUE(has_issue(r, "can.log_path", "no log_path", 2)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "can.controller_address", "cannot share an address", 4)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 2U) << dump(r);
+  const auto n = load_config_text("can: [socketcan]\n", "s.yaml");
+  EXPECT_FALSE(n.ok());
+}
+
+}  // namespace
+}  // namespace fieldguard::app
