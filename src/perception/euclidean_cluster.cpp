@@ -249,6 +249,17 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   // one with the larger radius reaches the other, so every joining pair is tested from at least one side.
   std::uint32_t* parent = parent_.data();
   const float* r2 = sorted_r2_.data();
+  // The gap between two cells `d` apart on an axis (a whole cell less, taken short by kSlack), for every
+  // offset a cell's reach covers: looked up per neighbour instead of computed.
+  float max_reach2 = 0.F;
+  for (std::uint32_t c = 0; c < ncells; ++c) max_reach2 = std::max(max_reach2, cells_[c].reach2);
+  const auto max_reach = static_cast<std::int64_t>(std::sqrt(max_reach2) / edge) + 1;
+  gaps_.resize(static_cast<std::size_t>(2 * max_reach + 1));
+  for (std::int64_t d = -max_reach; d <= max_reach; ++d) {
+    const std::int64_t g = d < 0 ? -d - 1 : d - 1;
+    gaps_[static_cast<std::size_t>(d + max_reach)] = g > 0 ? static_cast<float>(g) * edge - kSlack : 0.F;
+  }
+  const float* gap_at = gaps_.data() + max_reach;  // gap_at[d], d in [-max_reach, max_reach]
   for (std::uint32_t a = 0; a < ncells; ++a) {
     const Cell& ca = cells_[a];
     const std::uint32_t a0 = ca.first, a1 = cells_[a + 1].first;
@@ -257,26 +268,24 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     const auto ax = static_cast<std::int64_t>(ca.col / ny), ay = static_cast<std::int64_t>(ca.col % ny);
     const auto az = static_cast<std::int64_t>(ca.iz);
     std::uint32_t ra = find_root(parent, a);  // kept up to date: only this loop joins a's root to another
-    const auto gap = [edge](std::int64_t d) {
-      const std::int64_t g = d < 0 ? -d - 1 : d - 1;
-      return g > 0 ? static_cast<float>(g) * edge - kSlack : 0.F;
-    };
     for (std::int64_t x = std::max<std::int64_t>(0, ax - reach);
          x <= std::min<std::int64_t>(ax + reach, static_cast<std::int64_t>(nx) - 1); ++x) {
-      const float gx = gap(x - ax);
+      const float gx = gap_at[x - ax];
       for (std::int64_t y = std::max<std::int64_t>(0, ay - reach);
            y <= std::min<std::int64_t>(ay + reach, static_cast<std::int64_t>(ny) - 1); ++y) {
-        const float gy = gap(y - ay);
+        const auto col = static_cast<std::size_t>(x) * ny + static_cast<std::size_t>(y);
+        const std::uint32_t first = col_cells_[col], last = col_cells_[col + 1];
+        if (first == last) continue;  // an empty column (most are)
+        const float gy = gap_at[y - ay];
         const float gxy = gx * gx + gy * gy;
         if (!(gxy < reach2)) continue;
-        const auto col = static_cast<std::size_t>(x) * ny + static_cast<std::size_t>(y);
-        for (std::uint32_t b = col_cells_[col]; b < col_cells_[col + 1]; ++b) {
+        for (std::uint32_t b = first; b < last; ++b) {
           const Cell& cb = cells_[b];
           if (b == a) continue;
           const std::int64_t dz = static_cast<std::int64_t>(cb.iz) - az;
           if (dz > reach) break;  // cells of a column ascend in z
           if (dz < -reach) continue;
-          const float gz = gap(dz);
+          const float gz = gap_at[dz];
           if (!(gxy + gz * gz < reach2)) continue;
           const std::uint32_t rb = find_root(parent, b);
           if (ra == rb) continue;

@@ -8,6 +8,8 @@
 #include <limits>
 #include <numbers>
 
+#include "perception/simd.hpp"
+
 namespace fieldguard::perception {
 namespace {
 
@@ -68,31 +70,143 @@ void sort_points(std::vector<P2>& pts, HullScratch& s) {
   for (std::size_t i = 0; i < n; ++i) pts[i] = P2{from_ordered_bits(s.keys[i] >> 32U), from_ordered_bits(s.keys[i])};
 }
 
+namespace {
+
+// Directions of the extreme points that span the pre-filter's polygon: 16, counter-clockwise from -x.
+constexpr std::size_t kHullDirs = 16;
+struct HullDirs {
+  std::array<float, kHullDirs> x{}, y{};
+  HullDirs() {
+    for (std::size_t k = 0; k < kHullDirs; ++k) {
+      const double a = std::numbers::pi + 2.0 * std::numbers::pi * static_cast<double>(k) / kHullDirs;
+      x[k] = static_cast<float>(std::cos(a));
+      y[k] = static_cast<float>(std::sin(a));
+    }
+  }
+};
+
+// Leaves out of `all` the points that cannot be hull vertices, into `kept` (input order): the points extreme
+// along 16 directions span a polygon inside the hull, and a point strictly inside every edge of it is no hull
+// vertex (strictly left of every edge of a closed chain of input points means inside their hull, whatever
+// their order). The test is in float, so a point is left out only when it is inside by a margin far above the
+// float error of the test; points on or near an edge are kept and the exact hull below decides.
+// Most of a dense footprint (a wall of thousands of points) is left out.
+void drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
+  static const HullDirs dirs;
+  const std::size_t n = all.size();
+  // Extreme points four at a time: per direction and lane the best value and the first index reaching it,
+  // then the lanes reduced (greatest value, then smallest index: the first of equals, deterministic).
+  std::array<simd::f32x4, kHullDirs> best_v{};
+  std::array<simd::i32x4, kHullDirs> best_i{};
+  best_v.fill(simd::splat(-std::numeric_limits<float>::infinity()));
+  best_i.fill(simd::splat(std::int32_t{0}));
+  simd::f32x4 lo_x = simd::splat(all[0][0]), hi_x = lo_x, lo_y = simd::splat(all[0][1]), hi_y = lo_y;
+  const auto load4 = [&](std::size_t i, simd::f32x4& px, simd::f32x4& py) {
+    simd::f32x4 a, b;
+    std::memcpy(&a, &all[i], sizeof a);
+    std::memcpy(&b, &all[i + 2], sizeof b);
+    px = __builtin_shufflevector(a, b, 0, 2, 4, 6);
+    py = __builtin_shufflevector(a, b, 1, 3, 5, 7);
+  };
+  const std::size_t n4 = n - n % 4;
+  simd::i32x4 idx{0, 1, 2, 3};
+  for (std::size_t i = 0; i < n4; i += 4, idx += 4) {
+    simd::f32x4 px, py;
+    load4(i, px, py);
+    lo_x = px < lo_x ? px : lo_x;
+    hi_x = px > hi_x ? px : hi_x;
+    lo_y = py < lo_y ? py : lo_y;
+    hi_y = py > hi_y ? py : hi_y;
+    for (std::size_t k = 0; k < kHullDirs; ++k) {
+      const simd::f32x4 v = simd::splat(dirs.x[k]) * px + simd::splat(dirs.y[k]) * py;
+      const simd::i32x4 better = v > best_v[k];
+      best_v[k] = better ? v : best_v[k];
+      best_i[k] = better ? idx : best_i[k];
+    }
+  }
+  std::array<std::size_t, kHullDirs> ext{};
+  std::array<float, kHullDirs> best{};
+  best.fill(-std::numeric_limits<float>::infinity());
+  for (std::size_t k = 0; k < kHullDirs; ++k) {
+    for (std::size_t j = 0; j < 4 && n4 > 0; ++j) {
+      const auto at = static_cast<std::size_t>(best_i[k][j]);
+      if (best_v[k][j] > best[k] || (best_v[k][j] == best[k] && at < ext[k])) {
+        best[k] = best_v[k][j];
+        ext[k] = at;
+      }
+    }
+  }
+  float min_x = std::min(std::min(lo_x[0], lo_x[1]), std::min(lo_x[2], lo_x[3]));
+  float max_x = std::max(std::max(hi_x[0], hi_x[1]), std::max(hi_x[2], hi_x[3]));
+  float min_y = std::min(std::min(lo_y[0], lo_y[1]), std::min(lo_y[2], lo_y[3]));
+  float max_y = std::max(std::max(hi_y[0], hi_y[1]), std::max(hi_y[2], hi_y[3]));
+  for (std::size_t i = n4; i < n; ++i) {  // the last few, one by one (after every earlier index)
+    const float x = all[i][0], y = all[i][1];
+    min_x = std::min(min_x, x);
+    max_x = std::max(max_x, x);
+    min_y = std::min(min_y, y);
+    max_y = std::max(max_y, y);
+    for (std::size_t k = 0; k < kHullDirs; ++k) {
+      const float v = dirs.x[k] * x + dirs.y[k] * y;
+      if (v > best[k]) {
+        best[k] = v;
+        ext[k] = i;
+      }
+    }
+  }
+  // The polygon's edges without repeated corners (a corner extreme along several directions), as lines.
+  std::array<simd::f32x4, kHullDirs> ax{}, ay{}, ex{}, ey{}, tol{};
+  std::size_t edges = 0;
+  const float span = std::max(max_x - min_x, max_y - min_y);
+  for (std::size_t k = 0; k < kHullDirs; ++k) {
+    const P2& a = all[ext[k]];
+    const P2& b = all[ext[(k + 1) % kHullDirs]];
+    if (a == b) continue;
+    const float dx = b[0] - a[0], dy = b[1] - a[1];
+    ax[edges] = simd::splat(a[0]);
+    ay[edges] = simd::splat(a[1]);
+    ex[edges] = simd::splat(dx);
+    ey[edges] = simd::splat(dy);
+    // |dx * (py - ay) - dy * (px - ax)| <= (|dx| + |dy|) * span; float rounds each of its four operations by
+    // 2^-24 relative at most: 1e-5 of that bound is some fifty times the worst error.
+    tol[edges] = simd::splat(1e-5F * (std::fabs(dx) + std::fabs(dy)) * (span + 1.F));
+    ++edges;
+  }
+  kept.clear();
+  if (edges < 3) {  // all points on one line, or nearly: nothing to leave out safely
+    kept.assign(all.begin(), all.end());
+    return;
+  }
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    simd::f32x4 px, py;
+    load4(i, px, py);
+    simd::i32x4 inside = simd::splat(std::int32_t{-1});
+    for (std::size_t k = 0; k < edges; ++k) {
+      inside &= (ex[k] * (py - ay[k]) - ey[k] * (px - ax[k])) > tol[k];
+    }
+    const unsigned m = simd::mask_bits(inside);
+    if (m == 0xFU) continue;
+    for (std::size_t j = 0; j < 4; ++j) {
+      if ((m & (1U << j)) == 0U) kept.push_back(all[i + j]);
+    }
+  }
+  for (; i < n; ++i) {
+    bool inside = true;
+    for (std::size_t k = 0; k < edges; ++k) {
+      inside = inside && (ex[k][0] * (all[i][1] - ay[k][0]) - ey[k][0] * (all[i][0] - ax[k][0])) > tol[k][0];
+    }
+    if (!inside) kept.push_back(all[i]);
+  }
+}
+
+}  // namespace
+
 void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
   hull.clear();
   std::vector<P2>& scratch = hs.points;
   if (all.size() > 64) {
-    // Akl-Toussaint: the points extreme along x, x + y, y, y - x (both ways) span an octagon inside the hull;
-    // points strictly inside it cannot be hull vertices. A wall of thousands of points keeps a few dozen.
-    std::array<std::size_t, 8> ext{};
-    std::array<float, 8> best{};
-    best.fill(-std::numeric_limits<float>::max());
-    for (std::size_t i = 0; i < all.size(); ++i) {
-      const float x = all[i][0], y = all[i][1];
-      const float key[8] = {-x, -x - y, -y, x - y, x, x + y, y, y - x};  // counter-clockwise from min x
-      for (std::size_t k = 0; k < 8; ++k) {
-        if (key[k] > best[k]) {
-          best[k] = key[k];
-          ext[k] = i;
-        }
-      }
-    }
-    scratch.clear();
-    for (const P2& p : all) {
-      bool inside = true;
-      for (std::size_t k = 0; k < 8 && inside; ++k) inside = cross(all[ext[k]], all[ext[(k + 1) % 8]], p) > 0.0;
-      if (!inside) scratch.push_back(p);  // on or outside an edge: may be on the hull (corners are kept)
-    }
+    drop_interior(all, scratch);
   } else {
     scratch.assign(all.begin(), all.end());
   }
@@ -173,10 +287,17 @@ OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, HullS
   const Candidate* best = nullptr;
   std::size_t best_score = 0;
   std::size_t scored = 0;
+  const auto ties = [&](const Candidate& c) { return !(c.area > best_area * 1.01 + 1e-12); };
+  // One rectangle within 1 %: it wins whatever its score, so the points need not be counted.
+  const bool alone = std::count_if(cand, cand + count, ties) == 1;
   for (std::size_t k = 0; k < count && scored < 4; ++k) {  // (a circle-like hull ties everywhere: 4 suffice)
     const Candidate& c = cand[k];
-    if (c.area > best_area * 1.01 + 1e-12) continue;
+    if (!ties(c)) continue;
     ++scored;
+    if (alone) {
+      best = &c;
+      break;
+    }
     const double tol = std::max(0.05, 0.02 * std::max(c.u1 - c.u0, c.v1 - c.v0));
     std::size_t score = 0;
     for (const P2& p : pts) {

@@ -99,6 +99,72 @@ TEST(ConvexHull, ContainsEveryPoint) {
   for (const auto& p : few_hull) EXPECT_NE(std::find(pts.begin(), pts.end(), p), pts.end());
 }
 
+// The pre-filter (over 64 points) on a filled square grid: its corners are extreme along several of the
+// filter's directions at once, so the filter's polygon repeats them; the inside must still be left out (only
+// the outline, on the polygon's edges, may be kept) and the hull is the four corners.
+TEST(ConvexHull, PrefilterLeavesOutTheInsideOfASquare) {
+  std::vector<P2> pts, hull;
+  HullScratch scratch;
+  for (int i = 0; i < 100; ++i) {
+    for (int j = 0; j < 100; ++j)
+      pts.push_back({-5.F + 0.1F * static_cast<float>(i), 2.F + 0.1F * static_cast<float>(j)});
+  }
+  convex_hull(pts, hull, scratch);
+  EXPECT_LE(scratch.points.size(), 396U);  // the outline: 4 * 99 points
+  ASSERT_EQ(hull.size(), 4U);
+  EXPECT_EQ(hull[0], pts.front());
+  EXPECT_EQ(hull[1], pts[99 * 100]);
+  EXPECT_EQ(hull[2], pts.back());
+  EXPECT_EQ(hull[3], pts[99]);
+}
+
+// A hull vertex that is extreme along none of the filter's 16 directions, 10 um outside the line between
+// two that are: the float test must keep it (too near the edge to tell), and the exact hull finds it.
+TEST(ConvexHull, PrefilterKeepsAVertexJustOutsideItsPolygon) {
+  std::vector<P2> pts, hull;
+  HullScratch scratch;
+  // A filled triangle (0, 0), (10, -5), (10, 1), and above its top edge, at a third of its length, p.
+  for (int i = 0; i <= 40; ++i) {
+    const float x = 0.25F * static_cast<float>(i);
+    for (float y = -0.5F * x; y <= 0.1F * x; y += 0.25F) pts.push_back({x, y});
+    pts.push_back({x, 0.1F * x});  // the top edge itself
+  }
+  const P2 p{10.F / 3.F, 1.F / 3.F + 1e-5F};
+  pts.push_back(p);
+  ASSERT_GT(pts.size(), 64U);
+  convex_hull(pts, hull, scratch);
+  EXPECT_EQ(hull, (std::vector<P2>{{0.F, 0.F}, {10.F, -5.F}, {10.F, 1.F}, p}));
+}
+
+// Interior points and points just inside the hull's edges (outside the filter's polygon, so kept by it, but
+// no vertices) around a 100-gon: the hull is the 100 corners, counter-clockwise from the lowest-leftmost.
+TEST(ConvexHull, PrefilterAroundAPolygonOfManyCorners) {
+  std::vector<P2> corners, pts, hull;
+  HullScratch scratch;
+  constexpr int kCorners = 100;
+  for (int k = 0; k < kCorners; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / kCorners;
+    corners.push_back({static_cast<float>(3.0 + 10.0 * std::cos(a)), static_cast<float>(-7.0 + 10.0 * std::sin(a))});
+  }
+  for (int k = 0; k < kCorners; ++k) {
+    const P2& a = corners[static_cast<std::size_t>(k)];
+    const P2& b = corners[static_cast<std::size_t>((k + 1) % kCorners)];
+    // The edge's midpoint, pulled towards the centre by a tenth of the edge's 5 mm sagitta.
+    const float mx = 0.5F * (a[0] + b[0]), my = 0.5F * (a[1] + b[1]);
+    pts.push_back({3.F + (mx - 3.F) * 0.9999F, -7.F + (my + 7.F) * 0.9999F});
+    for (int r = 1; r <= 9; ++r)
+      pts.push_back(
+          {3.F + (a[0] - 3.F) * 0.1F * static_cast<float>(r), -7.F + (a[1] + 7.F) * 0.1F * static_cast<float>(r)});
+  }
+  pts.insert(pts.end(), corners.begin(), corners.end());
+  convex_hull(pts, hull, scratch);
+  ASSERT_EQ(hull.size(), corners.size());
+  const auto first = std::min_element(corners.begin(), corners.end());  // lowest x, then y
+  std::vector<P2> expected(first, corners.end());
+  expected.insert(expected.end(), corners.begin(), first);
+  EXPECT_EQ(hull, expected);
+}
+
 TEST(SizeClass, PersonSizedIsSmall) {
   EXPECT_EQ(size_class(0.6F, 0.4F, 1.8F), SizeClass::Small);
   EXPECT_EQ(size_class(1.2F, 1.2F, 2.2F), SizeClass::Small);

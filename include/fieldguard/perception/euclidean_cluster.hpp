@@ -84,6 +84,7 @@ class EuclideanClusterer {
   Buffer<std::uint32_t> parent_;     // union-find over cells
   Buffer<std::uint32_t> cluster_of_root_;
   Buffer<std::uint8_t> mark_;
+  Buffer<float> gaps_;  // grid: the gap between cells per offset
 };
 
 }  // namespace fieldguard::perception

@@ -31,7 +31,8 @@ struct HullScratch {
 };
 
 // Convex hull of `pts` counter-clockwise without collinear points, from the lowest-leftmost point (Andrew's
-// monotone chain; points inside the Akl-Toussaint octagon left out first; large sets sorted by radix).
+// monotone chain; of over 64 points, those inside the Akl-Toussaint polygon of the extremes along 16
+// directions left out first; large sets sorted by radix).
 void convex_hull(std::span<const std::array<float, 2>> pts, std::vector<std::array<float, 2>>& hull,
                  HullScratch& scratch);
 
