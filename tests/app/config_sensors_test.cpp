@@ -5,22 +5,14 @@
 #include <algorithm>
 #include <string>
 
+#include "app/config_issues.hpp"
 #include "fieldguard/app/config.hpp"
 
 namespace fieldguard::app {
 namespace {
 
-bool has_issue(const LoadResult& r, const std::string& key, const std::string& words, int line) {
-  return std::any_of(r.issues.begin(), r.issues.end(), [&](const ConfigIssue& i) {
-    return i.key_path == key && i.message.find(words) != std::string::npos && i.line == line;
-  });
-}
-
-std::string dump(const LoadResult& r) {
-  std::string s;
-  for (const auto& i : r.issues) s += i.to_string() + "\n";
-  return s;
-}
+using testing::dump;
+using testing::has_issue;
 
 TEST(ConfigSensors, ReadsEveryKey) {
   const auto r = load_config_text(R"(

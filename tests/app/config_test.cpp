@@ -1,3 +1,4 @@
+#include "app/config_issues.hpp"
 #include "fieldguard/app/config.hpp"
 
 #include <gtest/gtest.h>
@@ -13,17 +14,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool has_issue(const LoadResult& r, const std::string& key_path, const std::string& words, int line = -1) {
-  return std::any_of(r.issues.begin(), r.issues.end(), [&](const ConfigIssue& i) {
-    return i.key_path == key_path && i.message.find(words) != std::string::npos && (line < 0 || i.line == line);
-  });
-}
-
-std::string dump(const LoadResult& r) {
-  std::string s;
-  for (const auto& i : r.issues) s += i.to_string() + "\n";
-  return s;
-}
+using testing::dump;
+using testing::has_issue;
 
 TEST(ConfigFiles, EveryShippedFileIsValid) {
   int count = 0;
