@@ -22,6 +22,7 @@
 
 #include "fieldguard/drivers/scip.hpp"
 #include "options.hpp"
+#include "scip_sensor.hpp"
 
 namespace {
 
@@ -47,12 +48,6 @@ struct Options {
   long max_clients = -1;
 };
 
-// A status or echo line with its check character ("00" -> "00P").
-std::string with_check(const std::string& s) { return s + scip::check_code(s) + "\n"; }
-
-// "LABEL:value;S" as the VV/PP/II replies have it: the check covers LABEL:value.
-std::string info_line(const std::string& kv) { return kv + ";" + scip::check_code(kv) + "\n"; }
-
 // Range in mm at `step` of the emulated scene.
 std::uint32_t range_mm(int step, const Options& o, std::uint32_t scan_index) {
   const double a = (step - 540) * 0.25 * std::numbers::pi / 180.0;  // + counter-clockwise, 0 = front
@@ -68,21 +63,6 @@ std::uint32_t range_mm(int step, const Options& o, std::uint32_t scan_index) {
   return static_cast<std::uint32_t>(std::lround(r)) + (scan_index % 3);  // a little life in the numbers
 }
 
-std::string scan_reply(const std::string& echo, bool intensity, int first, int last, std::uint32_t index,
-                       std::uint32_t time_ms, const Options& o) {
-  std::string out = echo + "\n" + with_check("99");
-  std::string ts;
-  scip::encode_chars(time_ms & 0xFFFFFFU, 4, ts);
-  out += with_check(ts);
-  std::string data;
-  for (int step = first; step <= last; ++step) {
-    scip::encode_chars(range_mm(step, o, index), 3, data);
-    if (intensity) scip::encode_chars(1000 + static_cast<std::uint32_t>(step), 3, data);
-  }
-  for (std::size_t i = 0; i < data.size(); i += scip::kDataCharsPerLine) out += with_check(data.substr(i, scip::kDataCharsPerLine));
-  return out + "\n";
-}
-
 bool send_all(int fd, const std::string& s) {
   std::size_t done = 0;
   while (done < s.size()) {
@@ -95,19 +75,16 @@ bool send_all(int fd, const std::string& s) {
 
 void serve(int fd, const Options& o) {
   std::string pending;
-  bool laser = false;
-  bool streaming = false;
-  bool intensity = false;
-  int first = 0;
-  int last = 1080;
-  std::string stream_echo;
+  fieldguard::tools::ScipSensorIdentity identity;
+  identity.refuse_laser = o.refuse_laser;
+  fieldguard::tools::ScipSensor sensor(identity);
   std::uint32_t scans = 0;
   bool garbage_sent = false;
   const auto t0 = Clock::now();
   auto next_scan = t0;
   for (;;) {
     pollfd p{fd, POLLIN, 0};
-    const auto wait = streaming ? std::chrono::duration_cast<std::chrono::milliseconds>(next_scan - Clock::now()).count() : 1000;
+    const auto wait = sensor.streaming() ? std::chrono::duration_cast<std::chrono::milliseconds>(next_scan - Clock::now()).count() : 1000;
     const int r = ::poll(&p, 1, static_cast<int>(std::max<long long>(0, wait)));
     if (r < 0) return;
     if (r > 0) {
@@ -120,55 +97,23 @@ void serve(int fd, const Options& o) {
         std::string line = pending.substr(0, nl);
         pending.erase(0, nl + 1);
         if (line.empty()) continue;
-        const std::string cmd = line.substr(0, std::min<std::size_t>(2, line.size()));
-        std::string reply = line + "\n";
-        if (line.rfind("SCIP2.0", 0) == 0) {
-          reply += with_check("00") + "\n";
-        } else if (cmd == "VV") {
-          reply += with_check("00") + info_line("VEND:Hokuyo Automatic Co.,Ltd.") + info_line("PROD:SOKUIKI Sensor UTM-30LX-EW") +
-                   info_line("FIRM:1.1.3(fieldguard emulator)") + info_line("PROT:SCIP 2.0") + info_line("SERI:H0000000") + "\n";
-        } else if (cmd == "PP") {
-          reply += with_check("00") + info_line("MODL:UTM-30LX-EW") + info_line("DMIN:23") + info_line("DMAX:60000") +
-                   info_line("ARES:1440") + info_line("AMIN:0") + info_line("AMAX:1080") + info_line("AFRT:540") +
-                   info_line("SCAN:2400") + "\n";
-        } else if (cmd == "II") {
-          reply += with_check("00") + info_line("MODL:UTM-30LX-EW") + info_line(laser ? "LASR:ON" : "LASR:OFF") +
-                   info_line("SCSP:2400") + info_line("MESM:Measuring by Sensitive Mode") + info_line("SBPS:Ethernet 100 [Mbps]") +
-                   info_line("TIME:000000") + info_line("STAT:Stable 000 no error.") + "\n";
-        } else if (cmd == "BM") {
-          if (o.refuse_laser) reply += with_check("01") + "\n";
-          else {
-            reply += with_check(laser ? "02" : "00") + "\n";
-            laser = true;
-          }
-        } else if ((cmd == "MD" || cmd == "ME") && line.size() >= 15) {
-          first = std::atoi(line.substr(2, 4).c_str());
-          last = std::atoi(line.substr(6, 4).c_str());
-          if (first > last || last > 1080) {
-            reply += with_check("04") + "\n";
-          } else {
-            reply += with_check("00") + "\n";
-            laser = true;
-            streaming = true;
-            intensity = cmd == "ME";
-            stream_echo = line;
-            next_scan = Clock::now() + std::chrono::milliseconds(25);
-          }
-        } else if (cmd == "QT" || cmd == "RS") {
-          streaming = false;
-          laser = false;
-          reply += with_check("00") + "\n";
-        } else {
-          reply += with_check("0E") + "\n";
-        }
+        const bool was_streaming = sensor.streaming();
+        const std::string reply = sensor.reply(line);
+        if (sensor.streaming() && !was_streaming) next_scan = Clock::now() + std::chrono::milliseconds(25);
         if (!send_all(fd, reply)) return;
       }
       if (pending.size() > 4096) return;  // a client that sends no line ends: not a SCIP client
     }
-    if (streaming && Clock::now() >= next_scan) {
+    if (sensor.streaming() && Clock::now() >= next_scan) {
       next_scan += std::chrono::milliseconds(25);
       const auto ms = static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count());
-      const std::string s = scan_reply(stream_echo, intensity, first, last, scans, ms, o);
+      std::vector<std::uint32_t> ranges;
+      std::vector<std::uint32_t> intensities;
+      for (int step = sensor.first_step(); step <= sensor.last_step(); ++step) {
+        ranges.push_back(range_mm(step, o, scans));
+        intensities.push_back(1000 + static_cast<std::uint32_t>(step));
+      }
+      const std::string s = sensor.scan(ranges, intensities, ms);
       if (o.drop_after >= 0 && scans >= static_cast<std::uint32_t>(o.drop_after)) {
         send_all(fd, s.substr(0, s.size() / 2));
         return;  // the caller closes the socket in the middle of the scan

@@ -1,10 +1,12 @@
 // fieldguard-sim: writes an HDL-32E capture (classic pcap) of a simulated scene and its ground truth (JSONL).
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -13,6 +15,7 @@
 #include "sim/hdl32e.hpp"
 #include "sim/pcap_writer.hpp"
 #include "sim/scenes.hpp"
+#include "sim/session.hpp"
 #include "sim/simulator.hpp"
 #include "sim/truth_writer.hpp"
 
@@ -23,14 +26,23 @@ using namespace fieldguard::sim;
 constexpr std::int64_t kDefaultStartS = 1718449170;  // 2024-06-15 10:59:30 UTC: the hour turns after 30 s
 
 void usage(std::ostream& os) {
-  os << "usage: fieldguard-sim --scene NAME --pcap FILE [--truth FILE] [--rotations N] [--rate HZ]\n"
-        "                      [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
+  os << "usage: fieldguard-sim --scene NAME (--pcap FILE | --session DIR) [--truth FILE] [--rotations N]\n"
+        "                      [--rate HZ] [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
+        "                      [--antenna X,Y,Z] [--origin LAT,LON,H] [--heading DEG]\n"
         "       fieldguard-sim --list-scenes | --help\n\n"
         "Simulates a Velodyne HDL-32E (strongest return, 0x37/0x21, 2 mm units) 0.95 m above a field at the\n"
         "front of a tractor and writes its data packets as a classic pcap (Ethernet/IPv4/UDP to port 2368,\n"
         "record time = packet time = its last firing) plus one ground-truth JSON line per rotation.\n\n"
         "  --scene NAME        one of the scenes below\n"
         "  --pcap FILE         capture to write\n"
+        "  --session DIR       also write the other sensors as `fieldguard record` does: DIR/lidar.pcap (unless\n"
+        "                      --pcap), DIR/gnss.log (NMEA GGA, RMC, HDT at 10 Hz, RTK noise), DIR/ahrs.log (Xsens\n"
+        "                      MTData2 at 100 Hz: counter, SampleTimeFine, Euler ENU), DIR/scan2d.log (SCIP 2.0\n"
+        "                      MD session of a UTM-30LX-EW on the front bumper, 40 Hz) and DIR/pose.truth.jsonl\n"
+        "  --antenna X,Y,Z     GNSS antenna in the vehicle frame (origin on the ground below the rear axle;\n"
+        "                      default 0,0,2.8: on the cab roof)\n"
+        "  --origin LAT,LON,H  the world origin (WGS84 deg, deg, m; default 48.1,11.6,520: north of Munich)\n"
+        "  --heading DEG       compass heading of the tractor's path (default 60)\n"
         "  --truth FILE        ground truth to write (default: FILE without .pcap + .truth.jsonl)\n"
         "  --rotations N       rotations to simulate (default: the scene's)\n"
         "  --rate HZ           rotation rate, 5..20 (default 10); rounded to a whole number of packets per\n"
@@ -81,7 +93,20 @@ struct Options {
   std::int64_t start_s = kDefaultStartS;
   unsigned threads = 1;
   bool quiet = false;
+  std::string session;
+  Vec3 antenna{0.0, 0.0, 2.8};
+  Geodetic origin{48.1, 11.6, 520.0};
+  double heading_deg = 60.0;
 };
+
+// "a,b,c": exactly three numbers.
+bool parse_triple(std::string_view s, double& a, double& b, double& c) {
+  const std::size_t p1 = s.find(',');
+  const std::size_t p2 = p1 == std::string_view::npos ? p1 : s.find(',', p1 + 1);
+  if (p2 == std::string_view::npos) return false;
+  return parse_number(s.substr(0, p1), a) && parse_number(s.substr(p1 + 1, p2 - p1 - 1), b) && parse_number(s.substr(p2 + 1), c) &&
+         std::isfinite(a) && std::isfinite(b) && std::isfinite(c);
+}
 
 int bad_usage(const std::string& msg) {
   std::cerr << "fieldguard-sim: " << msg << "\n(fieldguard-sim --help lists the options and scenes)\n";
@@ -117,6 +142,22 @@ int main(int argc, char** argv) {
       opt.scene = *v;
     } else if (a == "--pcap") {
       opt.pcap = *v;
+    } else if (a == "--session") {
+      opt.session = *v;
+    } else if (a == "--antenna") {
+      if (!parse_triple(*v, opt.antenna.x, opt.antenna.y, opt.antenna.z) || std::abs(opt.antenna.x) > 20.0 ||
+          std::abs(opt.antenna.y) > 5.0 || opt.antenna.z < 0.0 || opt.antenna.z > 6.0) {
+        return bad_usage("--antenna wants X,Y,Z in metres on the tractor (|x| <= 20, |y| <= 5, 0 <= z <= 6), not '" + std::string(*v) + "'");
+      }
+    } else if (a == "--origin") {
+      if (!parse_triple(*v, opt.origin.lat_deg, opt.origin.lon_deg, opt.origin.h_m) || std::abs(opt.origin.lat_deg) > 85.0 ||
+          std::abs(opt.origin.lon_deg) > 180.0 || std::abs(opt.origin.h_m) > 9000.0) {
+        return bad_usage("--origin wants LAT,LON,H (|lat| <= 85 deg, |lon| <= 180 deg, |h| <= 9000 m), not '" + std::string(*v) + "'");
+      }
+    } else if (a == "--heading") {
+      if (!parse_number(*v, opt.heading_deg) || !(opt.heading_deg >= 0.0 && opt.heading_deg < 360.0)) {
+        return bad_usage("--heading wants degrees from 0 to 360 (clockwise from north), not '" + std::string(*v) + "'");
+      }
     } else if (a == "--truth") {
       opt.truth = *v;
     } else if (a == "--rotations") {
@@ -142,7 +183,16 @@ int main(int argc, char** argv) {
   if (opt.scene.empty()) return bad_usage("--scene is required (--list-scenes lists them)");
   const SceneInfo* info = find_scene(opt.scene);
   if (info == nullptr) return bad_usage("unknown scene '" + opt.scene + "' (--list-scenes lists them)");
-  if (opt.pcap.empty()) return bad_usage("--pcap FILE is required");
+  if (opt.pcap.empty() && !opt.session.empty()) opt.pcap = opt.session + "/lidar.pcap";
+  if (opt.pcap.empty()) return bad_usage("--pcap FILE or --session DIR is required");
+  if (!opt.session.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(opt.session, ec);
+    if (ec) {
+      std::cerr << "fieldguard-sim: cannot create " << opt.session << ": " << ec.message() << "\n";
+      return 1;
+    }
+  }
   if (opt.truth.empty()) {
     std::string base = opt.pcap;
     if (base.size() > 5 && base.ends_with(".pcap")) base.resize(base.size() - 5);
@@ -194,6 +244,22 @@ int main(int argc, char** argv) {
     std::cerr << "fieldguard-sim: writing failed: " << (pcap.error().empty() ? opt.truth : pcap.error()) << "\n";
     return 1;
   }
+  SessionCounts session_counts;
+  if (!opt.session.empty()) {
+    SessionSettings ss;
+    ss.dir = opt.session;
+    ss.seed = opt.seed;
+    ss.start_time_ns = settings.start_time_ns;
+    ss.duration_s = rotations * sim.period_s();
+    ss.origin = opt.origin;
+    ss.field_heading_deg = opt.heading_deg;
+    ss.antenna = opt.antenna;
+    std::string error;
+    if (!write_session(sim.scene(), ss, session_counts, error)) {
+      std::cerr << "fieldguard-sim: " << error << "\n";
+      return 1;
+    }
+  }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!opt.quiet) {
     std::fprintf(stderr,
@@ -202,6 +268,12 @@ int main(int argc, char** argv) {
                  opt.scene.c_str(), static_cast<unsigned long long>(opt.seed), rotations, 1.0 / sim.period_s(),
                  sim.packets_per_rotation(), static_cast<unsigned long long>(packet_count),
                  static_cast<double>(points) / rotations, secs, rotations / secs, opt.pcap.c_str(), opt.truth.c_str());
+    if (!opt.session.empty()) {
+      std::fprintf(stderr, "  %s: %llu GNSS epochs, %llu AHRS samples, %llu 2D scans\n", opt.session.c_str(),
+                   static_cast<unsigned long long>(session_counts.gnss_epochs),
+                   static_cast<unsigned long long>(session_counts.ahrs_samples),
+                   static_cast<unsigned long long>(session_counts.scans));
+    }
   }
   return 0;
 }

@@ -1,5 +1,6 @@
 #include "sim/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fieldguard::sim {
@@ -12,6 +13,8 @@ std::string_view to_string(ObjectClass c) {
     case ObjectClass::House: return "house";
     case ObjectClass::Tree: return "tree";
     case ObjectClass::Crown: return "crown";
+    case ObjectClass::Pole: return "pole";
+    case ObjectClass::Box: return "box";
     case ObjectClass::Clod: return "clod";
     case ObjectClass::Ridge: return "ridge";
     case ObjectClass::Crop: return "crop";
@@ -24,12 +27,26 @@ bool is_terrain(ObjectClass c) {
   return c == ObjectClass::Clod || c == ObjectClass::Ridge || c == ObjectClass::Crop || c == ObjectClass::Body;
 }
 
+std::pair<double, double> Scene::travel_at(double t_s) const {
+  const MotionParams& m = motion;
+  if (!std::isfinite(m.stop_x_m) || m.speed_mps <= 0.0 || m.decel_mps2 <= 0.0) {
+    return {m.start_x_m + m.speed_mps * t_s, m.speed_mps};
+  }
+  const double v = m.speed_mps;
+  const double brake_s = v / m.decel_mps2;
+  const double t_brake = std::max(0.0, (m.stop_x_m - m.start_x_m - 0.5 * v * brake_s) / v);
+  if (t_s < t_brake) return {m.start_x_m + v * t_s, v};
+  const double tau = std::min(t_s - t_brake, brake_s);
+  return {m.start_x_m + v * t_brake + v * tau - 0.5 * m.decel_mps2 * tau * tau, v - m.decel_mps2 * tau};
+}
+
 SensorPose Scene::pose_at(double t_s) const {
   const MotionParams& m = motion;
-  const double x = m.start_x_m + m.speed_mps * t_s;
+  const auto [x, speed] = travel_at(t_s);
   const double ground = terrain.base(x, 0.0);
-  double roll = m.roll_deg + m.roll_amp_deg * std::sin(2.0 * kPi * t_s / m.roll_period_s);
-  double pitch = m.pitch_deg + m.pitch_amp_deg * std::sin(2.0 * kPi * t_s / m.pitch_period_s + 1.3);
+  const double rock = m.rock_with_speed && m.speed_mps > 0.0 ? speed / m.speed_mps : 1.0;
+  double roll = m.roll_deg + rock * m.roll_amp_deg * std::sin(2.0 * kPi * t_s / m.roll_period_s);
+  double pitch = m.pitch_deg + rock * m.pitch_amp_deg * std::sin(2.0 * kPi * t_s / m.pitch_period_s + 1.3);
   if (m.vibration_deg != 0.0) {
     roll += m.vibration_deg * std::sin(2.0 * kPi * 2.3 * t_s + 0.4);
     pitch += m.vibration_deg * std::sin(2.0 * kPi * 3.1 * t_s + 2.1);

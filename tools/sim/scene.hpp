@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "sim/crop.hpp"
@@ -20,6 +21,7 @@ namespace fieldguard::sim {
 
 enum class ObjectClass : std::uint8_t {
   Pedestrian, Implement, Haystack, House, Tree, Crown,  // real objects: a detector must report them
+  Pole, Box,
   Clod, Ridge, Crop, Body,                              // terrain and the tractor: it must not
 };
 [[nodiscard]] std::string_view to_string(ObjectClass c);
@@ -44,6 +46,11 @@ struct MotionParams {
   double pitch_amp_deg = 0.0;
   double pitch_period_s = 4.0;
   double vibration_deg = 0.0;    // engine/ride vibration, a few Hz, on both axes
+  // Braking: the tractor slows at decel_mps2 to stand with its sensor at world x = stop_x_m (inf = never).
+  double stop_x_m = kInf;
+  double decel_mps2 = 0.5;
+  bool rock_with_speed = false;  // the rocking amplitudes scale with the speed: a standing tractor does not rock
+  double lidar_forward_m = 3.6;  // the sensor's x in the vehicle frame (origin on the ground below the rear axle)
 };
 
 struct SensorNoise {
@@ -71,6 +78,8 @@ struct Scene {
   SensorNoise noise;
 
   [[nodiscard]] SensorPose pose_at(double t_s) const;
+  // The sensor's world x and the speed (m/s) at t_s.
+  [[nodiscard]] std::pair<double, double> travel_at(double t_s) const;
   // Moves the pedestrian (if any) to time t_s.
   void animate(double t_s);
 };

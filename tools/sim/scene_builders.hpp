@@ -29,5 +29,6 @@ void add_crossings(Scene& s, const SceneSetup& setup);
 [[nodiscard]] Scene farmyard(const SceneSetup& setup);
 [[nodiscard]] Scene orchard(const SceneSetup& setup);
 [[nodiscard]] Scene shed(const SceneSetup& setup);
+[[nodiscard]] Scene uneven_drive(const SceneSetup& setup);
 
 }  // namespace fieldguard::sim::detail

@@ -9,7 +9,7 @@ namespace fieldguard::sim {
 
 namespace {
 
-constexpr std::array<SceneInfo, 7> kScenes{{
+constexpr std::array<SceneInfo, 8> kScenes{{
     {"flat", "flat bare ground (no furrows, no slope), the tractor's body, a parked implement at 11-14 m "
              "ahead and a round bale at 8 m front-left; stationary, level; 1 cm noise, 1% dropouts. For "
              "checking the decoder against the simulator.", 20},
@@ -39,6 +39,12 @@ constexpr std::array<SceneInfo, 7> kScenes{{
              "roof at 5.5 m) with an implement, bales and a person standing: nearly every ray returns (about "
              "69,000 points per rotation at 10 Hz, 138,000 at 5 Hz), for benchmarks; 1 cm noise, 0.3% "
              "dropouts. The walls and roof are objects of class house.", 50},
+    {"uneven-drive", "the sensor-fusion scene (use --session): the LiDAR on a mast 1.8 m up at the front, the "
+                     "tractor driving 1.5 m/s across an uneven field (swells up to 0.45 m, rocking with the "
+                     "speed: roll and pitch up to 8 deg), past a pole (0.1 x 0.1 x 2 m, 3 m left of the path, "
+                     "halfway), then braking to stand for the last quarter of the run (at most 6 s) with a low "
+                     "box (0.4 m tall, 0.6 m wide, 0.4 m deep) 1 m in front of its bumper: below the LiDAR's "
+                     "lowest beam, in the bumper 2D LiDAR's plane; 1.5 cm noise, 2% dropouts.", 600},
 }};
 
 }  // namespace
@@ -60,6 +66,7 @@ std::optional<Scene> build_scene(std::string_view name, const SceneSetup& setup)
   if (name == "farmyard") return detail::farmyard(setup);
   if (name == "orchard") return detail::orchard(setup);
   if (name == "shed") return detail::shed(setup);
+  if (name == "uneven-drive") return detail::uneven_drive(setup);
   return std::nullopt;
 }
 
