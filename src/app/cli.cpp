@@ -21,6 +21,7 @@ constexpr const char* kUsage =
     "  check-config   validate a configuration file and list every problem\n"
     "  inspect        decode a capture (NMEA, Xsens, ...) into one JSON line per sample\n"
     "  record         save what the live sensors send, for replay\n"
+    "  run            the daemon: live sensors -> detection -> stop decision -> CAN\n"
     "\n"
     "options:\n"
     "  --help         this text; `fieldguard <command> --help` for a command's options\n"
@@ -49,6 +50,7 @@ int run_cli(int argc, char** argv) {
     if (cmd == "replay") return cmd_replay(rest);
     if (cmd == "inspect") return cmd_inspect(rest);
     if (cmd == "record") return cmd_record(rest);
+    if (cmd == "run") return cmd_run(rest);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fieldguard %s: internal error: %s\n", cmd.c_str(), e.what());
     return kExitFailure;

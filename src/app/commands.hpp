@@ -15,5 +15,6 @@ int cmd_check_config(const std::vector<std::string>& args);
 int cmd_replay(const std::vector<std::string>& args);
 int cmd_inspect(const std::vector<std::string>& args);
 int cmd_record(const std::vector<std::string>& args);
+int cmd_run(const std::vector<std::string>& args);
 
 }  // namespace fieldguard::app

@@ -41,4 +41,11 @@ void CanSchedule::frame(const FrameReport& report, const StopRequest& stop, Stam
   sink_.write(buf_, t);
 }
 
+void CanSchedule::stop(const StopRequest& stop, Stamp t) {
+  last_stop_ = stop;
+  buf_.clear();
+  buf_.push_back(encoder_.encode_stop(stop));
+  sink_.write(buf_, t);
+}
+
 }  // namespace fieldguard::output

@@ -96,5 +96,25 @@ TEST_F(CanScheduleTest, ALongGapSendsOneCycleNotABurst) {
   EXPECT_THROW(CanSchedule(enc, sink, Nanos{0}), std::invalid_argument);
 }
 
+TEST_F(CanScheduleTest, AStopDecidedBetweenFramesGoesOutAtOnceAndRepeats) {
+  const Signal& cmd = layout(MessageId::StopRequest).signals[stop_sig::Command];
+  const Signal& fault = layout(MessageId::StopRequest).signals[stop_sig::ReasonSensorFault];
+  sched.tick(Stamp{0}, Heartbeat{});
+  sched.frame(FrameReport{}, StopRequest{StopCommand::Go, {}}, Stamp{10 * kMs});
+  const std::size_t before = sink.sent.size();
+  sched.stop(StopRequest{StopCommand::Stop, StopReasons{.sensor_fault = true}}, Stamp{40 * kMs});
+  ASSERT_EQ(sink.sent.size(), before + 1);  // the stop request alone, no summary: no frame was decided
+  EXPECT_EQ(sink.sent.back().t.ns, 40 * kMs);
+  EXPECT_EQ(sink.sent.back().frame.id, enc.id_of(MessageId::StopRequest));
+  EXPECT_EQ(get_raw(sink.sent.back().frame.data, cmd), 1U);
+  EXPECT_EQ(get_raw(sink.sent.back().frame.data, fault), 1U);
+  sched.tick(Stamp{100 * kMs}, Heartbeat{});  // repeated by the next cycle, not the GO of the last frame
+  EXPECT_EQ(sink.sent.back().frame.id, enc.id_of(MessageId::StopRequest));
+  EXPECT_EQ(get_raw(sink.sent.back().frame.data, cmd), 1U);
+  EXPECT_EQ(get_raw(sink.sent.back().frame.data, fault), 1U);
+  ASSERT_TRUE(sched.last_stop().has_value());
+  EXPECT_EQ(sched.last_stop()->command, StopCommand::Stop);
+}
+
 }  // namespace
 }  // namespace fieldguard::output

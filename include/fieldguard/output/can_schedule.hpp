@@ -25,6 +25,9 @@ class CanSchedule {
   void tick(Stamp now, const Heartbeat& heartbeat);
   // One pipeline frame's messages at `t` (call tick(t, ...) first so the log stays in time order).
   void frame(const FrameReport& report, const StopRequest& stop, Stamp t);
+  // A stop request decided between frames (a sensor timing out, the pipeline stalling, shutting down): sent
+  // at `t` at once, and repeated by the following cycles until the next frame or stop() replaces it.
+  void stop(const StopRequest& stop, Stamp t);
 
   [[nodiscard]] std::uint64_t skipped_cycles() const { return skipped_; }
   [[nodiscard]] const std::optional<StopRequest>& last_stop() const { return last_stop_; }

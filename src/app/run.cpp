@@ -1,0 +1,507 @@
+// `fieldguard run`: the daemon. The live sources, the rotation cutter and the output stage share one
+// Boost.Asio io_context on the main thread (the io thread); perception runs on an OrderedPool of
+// pipeline.workers threads. A 5 ms timer on the io thread collects finished rotations in order, lets the
+// safety monitor decide on them and, between rotations, on the clock alone, and sends the CAN frames that
+// are due. Frames are the 3D LiDAR's rotations: the other sensors are watched for silence only.
+
+#include <pthread.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/args.hpp"
+#include "app/commands.hpp"
+#include "app/logging.hpp"
+#include "app/run_stage.hpp"
+#include "app/samples.hpp"
+#include "app/systemd_notify.hpp"
+#include "fieldguard/app/config.hpp"
+#include "fieldguard/drivers/velodyne_stream.hpp"
+#include "fieldguard/io/scip_source.hpp"
+#include "fieldguard/io/serial_reader.hpp"
+#include "fieldguard/io/udp_receiver.hpp"
+#include "fieldguard/output/can_sink.hpp"
+#include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/sync/health.hpp"
+#include "fieldguard/sync/ordered_pool.hpp"
+
+namespace fieldguard::app {
+namespace {
+
+namespace safety = output::safety;
+using SteadyClock = std::chrono::steady_clock;
+
+constexpr const char* kHelp =
+    "usage: fieldguard run --config FILE [--can-log FILE] [--quiet]\n"
+    "\n"
+    "The daemon: receives the enabled live sensors (3D LiDAR over UDP on lidar.data_port; the 2D LiDAR, GNSS\n"
+    "and AHRS when enabled), cuts the 3D LiDAR's stream into rotations, runs obstacle detection on\n"
+    "pipeline.workers threads, decides stop / go with the safety monitor (`safety:`) on every rotation and\n"
+    "between rotations (a silent sensor or a stalled pipeline stops the tractor within its timeout), and\n"
+    "sends the CAN messages of config/fieldguard.dbc to the `can:` sink (socketcan | candump | none),\n"
+    "heartbeat and stop request every can.heartbeat_period_s whatever the pipeline does.\n"
+    "\n"
+    "  --config FILE   configuration (see config/fieldguard.yaml)\n"
+    "  --can-log FILE  write the CAN frames to this candump -L log instead of the configured sink\n"
+    "  --quiet         no summary on exit\n"
+    "\n"
+    "Signals: SIGTERM / SIGINT end it within a second, after a last STOP (shutting down); SIGHUP reloads the\n"
+    "configuration file (a configuration with errors is refused, the errors are logged and the running one\n"
+    "stays; a good one restarts the sources and the pipeline, starting again from STOP, starting up).\n"
+    "Under systemd (Type=notify): READY=1 once every required sensor has been heard, WATCHDOG=1 fed by the\n"
+    "decisions (none while rotations wait in the pipeline longer than safety.max_frame_interval_s), STATUS=\n"
+    "a one-line health summary.\n"
+    "Exit code 0 after a signal, 2 for an unusable configuration or a sensor port that cannot be opened.\n";
+
+constexpr auto kTick = std::chrono::milliseconds(5);
+constexpr auto kStatusEvery = std::chrono::seconds(1);
+
+Stamp host_now() {
+  return Stamp{std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count()};
+}
+
+// can.sink: none. Frames are counted and go nowhere.
+class NullSink final : public output::CanSink {
+ public:
+  void write(std::span<const output::CanFrame> frames, Stamp) override { stats_.sent += frames.size(); }
+  [[nodiscard]] const output::CanSinkStats& stats() const override { return stats_; }
+
+ private:
+  output::CanSinkStats stats_;
+};
+
+// What the sink was made from: a reload keeps the open sink (and its log file) when this is unchanged.
+struct SinkKey {
+  CanSinkKind kind = CanSinkKind::None;
+  std::string interface;
+  std::string path;
+  bool operator==(const SinkKey&) const = default;
+};
+
+SinkKey sink_key(const Config& cfg, const std::optional<std::string>& can_log) {
+  if (can_log) return {CanSinkKind::Candump, cfg.can.interface, *can_log};
+  return {cfg.can.sink, cfg.can.interface, cfg.can.sink == CanSinkKind::Candump ? cfg.can.log_path : std::string()};
+}
+
+// Throws std::runtime_error / std::invalid_argument naming what failed.
+std::unique_ptr<output::CanSink> make_sink(const SinkKey& k) {
+  switch (k.kind) {
+    case CanSinkKind::Candump: return std::make_unique<output::CandumpLogSink>(k.path, k.interface);
+    case CanSinkKind::SocketCan: {
+      auto s = output::SocketCanSink::open(k.interface);
+      if (!s) throw std::runtime_error(s.error());
+      return std::make_unique<output::SocketCanSink>(std::move(s).value());
+    }
+    case CanSinkKind::None: break;
+  }
+  return std::make_unique<NullSink>();
+}
+
+io::SerialOptions serial_options(const SerialConfig& c) {
+  io::SerialOptions o;
+  o.device = c.device;
+  o.baud = c.baud;
+  o.data_bits = c.data_bits;
+  o.parity = c.parity;
+  o.stop_bits = c.stop_bits;
+  o.silence_timeout_s = c.silence_timeout_s;
+  o.reopen_interval_s = c.reopen_interval_s;
+  return o;
+}
+
+struct Job {
+  LidarFrame frame;
+  Stamp complete;  // receive time of the packet that completed the rotation
+};
+using Pool = sync::OrderedPool<Job, perception::FrameResult>;
+
+// A Pipeline keeps scratch buffers between rotations and is not thread-safe: each worker borrows one for a
+// rotation. There are as many as workers, so the set is never empty when a worker asks.
+class Pipelines {
+ public:
+  Pipelines(const perception::PipelineParams& params, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) free_.push_back(std::make_unique<perception::Pipeline>(params));
+  }
+  perception::FrameResult process(const LidarFrame& f) {
+    std::unique_ptr<perception::Pipeline> p;
+    {
+      const std::lock_guard lock(mutex_);
+      if (free_.empty()) throw std::logic_error("more workers than pipelines");
+      p = std::move(free_.back());
+      free_.pop_back();
+    }
+    struct Return {
+      Pipelines& set;
+      std::unique_ptr<perception::Pipeline>& p;
+      ~Return() {
+        const std::lock_guard lock(set.mutex_);
+        set.free_.push_back(std::move(p));
+      }
+    } give_back{*this, p};
+    return p->process(f.points);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<perception::Pipeline>> free_;
+};
+
+sync::SensorKind kind_of(safety::Sensor s) {
+  switch (s) {
+    case safety::Sensor::Lidar: return sync::SensorKind::Lidar3d;
+    case safety::Sensor::Scan2d: return sync::SensorKind::Scan2d;
+    case safety::Sensor::Gnss: return sync::SensorKind::Gnss;
+    case safety::Sensor::Ahrs: return sync::SensorKind::Ahrs;
+  }
+  return sync::SensorKind::Lidar3d;
+}
+
+// One configuration's worth of daemon: its sources, its worker pool and its output stage. A reload replaces
+// the whole session; the CAN sink outlives it.
+class Session {
+ public:
+  // `ready`: READY=1 was sent (by this process, for any session): the watchdog is fed only from then on.
+  Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink, SystemdNotifier& notify, bool& ready)
+      : io_(io),
+        cfg_(std::move(cfg)),
+        notify_(notify),
+        ready_(ready),
+        stage_(cfg_, sink),
+        stream_(velodyne_stream_options(cfg_.lidar)),
+        pipelines_(cfg_.perception, static_cast<std::size_t>(cfg_.pipeline.workers)),
+        pool_(pool_params(cfg_), [this](Job& j) { return process(j); }) {}
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+  Session(Session&&) = delete;
+  Session& operator=(Session&&) = delete;
+  ~Session() { stop(); }
+
+  // Throws std::system_error when the LiDAR's port cannot be bound.
+  void start() {
+    const Stamp now = host_now();
+    io::UdpReceiverOptions o;
+    o.port = cfg_.lidar.data_port;
+    udp_ = std::make_unique<io::UdpReceiver>(io_, o, [this](const io::UdpDatagram& d) { on_datagram(d); });
+    udp_->start();
+    log_->info("listening for the 3D LiDAR on udp port {}", udp_->local_port());
+    if (cfg_.scan2d.enabled) {
+      io::ScipSourceOptions so;
+      so.tcp.host = cfg_.scan2d.host;
+      so.tcp.port = cfg_.scan2d.port;
+      so.tcp.connect_timeout_s = cfg_.scan2d.connect_timeout_s;
+      so.tcp.silence_timeout_s = cfg_.scan2d.silence_timeout_s;
+      so.tcp.backoff_max_s = cfg_.scan2d.backoff_max_s;
+      so.client.scan.first_step = static_cast<std::uint16_t>(cfg_.scan2d.start_step);
+      so.client.scan.last_step = static_cast<std::uint16_t>(cfg_.scan2d.end_step);
+      so.client.intensity = cfg_.scan2d.intensity;
+      scip_ = std::make_unique<io::ScipSource>(
+          io_, so, [this](const scip::Scan&, const scip::Geometry&, Stamp t) { heard(safety::Sensor::Scan2d, t); },
+          [this](const std::string& w) { log_->info("scan2d: {}", w); });
+      scip_->start();
+    }
+    // GNSS and AHRS count as heard when their bytes arrive; their content is not checked here yet.
+    auto serial = [&](const SerialConfig& c, safety::Sensor s, const char* name) {
+      if (!c.enabled) return;
+      serial_.push_back(std::make_unique<io::SerialReader>(
+          io_, serial_options(c), [this, s](ByteSpan, Stamp t) { heard(s, t); },
+          [this, name](io::SerialState, const std::string& why) { log_->info("{}: {}", name, why); }));
+      serial_.back()->start();
+    };
+    serial(cfg_.gnss.serial, safety::Sensor::Gnss, "gnss");
+    serial(cfg_.ahrs.serial, safety::Sensor::Ahrs, "ahrs");
+    stage_.tick(now, 0);
+  }
+
+  // Sources closed, queued rotations discarded, the workers joined (each finishes its rotation first).
+  void stop() {
+    if (stopped_) return;
+    stopped_ = true;
+    if (udp_) udp_->stop();
+    if (scip_) scip_->stop();
+    for (auto& s : serial_) s->stop();
+    pool_.stop(sync::Drain::No);
+    pool_.poll([this](const Pool::Result& r) { deliver(r); });
+  }
+
+  void shutdown() { stage_.shutdown(host_now()); }
+
+  // The output timer: finished rotations in order, then a decision on the clock and the CAN cycles due.
+  void on_tick() {
+    pool_.poll([this](const Pool::Result& r) { deliver(r); });
+    const Stamp now = host_now();
+    stage_.tick(now, lost_);
+    // A decision on the clock is progress unless rotations are stuck in the pipeline: then the watchdog
+    // starves and systemd restarts a daemon whose workers no longer work.
+    const bool stalled = !submitted_.empty() && static_cast<double>(now.ns - submitted_.front().ns) * 1e-9 >
+                                                     cfg_.safety.max_frame_interval_s;
+    if (stalled != stalled_) {
+      stalled_ = stalled;
+      if (stalled) {
+        log_->error("pipeline stalled: {} rotations waiting, the oldest for {:.3f} s; no watchdog pings",
+                    submitted_.size(), static_cast<double>(now.ns - submitted_.front().ns) * 1e-9);
+      } else {
+        log_->warn("pipeline moving again");
+      }
+    }
+    if (!heard_all_ && stage_.started()) {
+      heard_all_ = true;
+      log_->info("every required sensor heard: ready");
+      if (!ready_) notify_.ready(status(now));
+      ready_ = true;
+      last_status_ = SteadyClock::now();
+    } else if (SteadyClock::now() - last_status_ >= kStatusEvery) {
+      last_status_ = SteadyClock::now();
+      notify_.status(status(now));
+    }
+    if (!stalled && ready_) notify_.progress(SteadyClock::now());
+  }
+
+  [[nodiscard]] std::string status(Stamp now) const {
+    std::optional<sync::SensorKind> waiting;
+    for (std::size_t i = 0; i < safety::kSensorCount && !waiting; ++i) {
+      const auto s = static_cast<safety::Sensor>(i);
+      const auto& p = cfg_.safety.sensor(s);
+      const auto age = health_.age_s(kind_of(s), now);
+      if (p.required && (!age || *age > p.timeout_s)) waiting = kind_of(s);
+    }
+    std::string line = health_.status_line(now, waiting, stage_.counts().frames, stream_.counters().partial_rotations);
+    if (const auto& d = stage_.last_decision()) {
+      line += d->stop ? " | STOP " + std::string(safety::to_string(d->reason)) : " | GO";
+    }
+    if (stalled_) line += " | pipeline stalled";
+    return line;
+  }
+
+  void print_summary() const {
+    const auto& c = stage_.counts();
+    const auto pc = pool_.counters();
+    std::printf("run summary: %s\n  rotations         %llu decided, %llu lost\n  stop decisions    %llu stop, %llu go, "
+                "%llu changes\n  pool              %llu submitted, %llu dropped, %llu refused, %llu failed\n",
+                cfg_.source_file.c_str(), static_cast<unsigned long long>(c.frames),
+                static_cast<unsigned long long>(lost_), static_cast<unsigned long long>(c.stop_frames),
+                static_cast<unsigned long long>(c.go_frames), static_cast<unsigned long long>(c.changes),
+                static_cast<unsigned long long>(pc.submitted), static_cast<unsigned long long>(pc.dropped),
+                static_cast<unsigned long long>(pc.refused), static_cast<unsigned long long>(pc.failed));
+  }
+
+  [[nodiscard]] const Config& config() const { return cfg_; }
+
+ private:
+  static sync::PoolParams pool_params(const Config& c) {
+    sync::PoolParams p;
+    p.workers = static_cast<std::size_t>(c.pipeline.workers);
+    p.queue_capacity = static_cast<std::size_t>(c.pipeline.queue_capacity);
+    p.drop = c.pipeline.drop == PipelineDrop::Oldest ? sync::DropPolicy::DropOldest : sync::DropPolicy::DropNewest;
+    return p;
+  }
+
+  perception::FrameResult process(Job& j) {
+    // Named so that `top -H`, a debugger and the stall test can tell the workers apart.
+    thread_local bool named = false;
+    if (!named) {
+      named = true;
+      pthread_setname_np(pthread_self(), "fg-perception");
+    }
+    return pipelines_.process(j.frame);
+  }
+
+  void heard(safety::Sensor s, Stamp t) {
+    stage_.sensor_data(s, t);
+    health_.sample(kind_of(s), t);
+  }
+
+  void on_datagram(const io::UdpDatagram& d) {
+    stage_.sensor_data(safety::Sensor::Lidar, d.host_time);
+    if (d.payload.size() != velodyne::kDataPacketSize) {
+      if (bad_length_++ == 0) log_->warn("3D LiDAR: a {}-byte datagram is not a data packet (counted)", d.payload.size());
+      return;
+    }
+    stream_.push(d.payload, d.host_time, frames_);
+    for (auto& f : frames_) {
+      health_.sample(sync::SensorKind::Lidar3d, d.host_time);
+      using std::swap;
+      swap(job_.frame, f);
+      job_.complete = d.host_time;
+      if (pool_.submit(job_)) {
+        submitted_.push_back(host_now());
+      } else {
+        ++lost_;
+      }
+    }
+    frames_.clear();
+  }
+
+  void deliver(const Pool::Result& r) {
+    if (!submitted_.empty()) submitted_.pop_front();
+    // Stopping: what the workers finish now must not follow the last STOP onto the bus.
+    if (stopped_) return;
+    if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
+      ++lost_;
+      if (r.outcome == sync::Outcome::Failed) {
+        log_->error("rotation {}: detection failed: {}", r.input->frame.index, r.error ? *r.error : "?");
+      }
+      return;
+    }
+    stage_.frame(r.input->frame, *r.output, r.input->complete, host_now(), lost_);
+    if (ready_) notify_.progress(SteadyClock::now());
+  }
+
+  boost::asio::io_context& io_;
+  const Config cfg_;
+  SystemdNotifier& notify_;
+  bool& ready_;
+  std::shared_ptr<spdlog::logger> log_ = logger("run");
+  LiveStage stage_;
+  velodyne::Stream stream_;
+  sync::HealthMonitor health_;
+  Pipelines pipelines_;
+  Pool pool_;
+  std::unique_ptr<io::UdpReceiver> udp_;
+  std::unique_ptr<io::ScipSource> scip_;
+  std::vector<std::unique_ptr<io::SerialReader>> serial_;
+  std::vector<LidarFrame> frames_;
+  Job job_;
+  std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
+  std::uint64_t lost_ = 0;       // rotations dropped, refused or failed
+  std::uint64_t bad_length_ = 0;
+  bool heard_all_ = false;
+  bool stalled_ = false;
+  bool stopped_ = false;
+  SteadyClock::time_point last_status_{};
+};
+
+}  // namespace
+
+int cmd_run(const std::vector<std::string>& argv) {
+  const Args args(argv, {"config", "can-log"}, {"help", "quiet"});
+  if (args.has("help")) {
+    std::fputs(kHelp, stdout);
+    return kExitOk;
+  }
+  if (!args.ok() || !args.positional().empty() || !args.has("config")) {
+    std::fprintf(stderr, "fieldguard run: %s\n%s",
+                 !args.ok()                    ? args.error().c_str()
+                 : !args.positional().empty() ? ("unexpected argument '" + args.positional().front() + "'").c_str()
+                                               : "--config is required",
+                 kHelp);
+    return kExitBadInput;
+  }
+  const std::string config_path = *args.get("config");
+  const std::optional<std::string> can_log = args.get("can-log");
+  const auto log = logger("run");
+  auto loaded = load_config_file(config_path);
+  if (!loaded.ok()) {
+    for (const auto& issue : loaded.issues) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
+    std::fprintf(stderr, "fieldguard run: invalid configuration %s\n", config_path.c_str());
+    return kExitBadInput;
+  }
+
+  SinkKey key = sink_key(loaded.config, can_log);
+  std::unique_ptr<output::CanSink> sink;
+  try {
+    sink = make_sink(key);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fieldguard run: CAN output: %s\n", e.what());
+    return kExitBadInput;
+  }
+  boost::asio::io_context io;
+  SystemdNotifier notify = SystemdNotifier::from_environment();
+  std::unique_ptr<Session> session;
+  bool ready = false;
+  auto open_session = [&](const Config& cfg) {
+    auto s = std::make_unique<Session>(io, cfg, *sink, notify, ready);
+    s->start();
+    return s;
+  };
+  try {
+    session = open_session(loaded.config);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fieldguard run: %s\n", e.what());
+    return kExitBadInput;
+  }
+
+  boost::asio::steady_timer timer(io);
+  std::function<void()> arm = [&] {
+    timer.expires_after(kTick);
+    timer.async_wait([&](const boost::system::error_code& ec) {
+      if (ec) return;
+      session->on_tick();
+      arm();
+    });
+  };
+  arm();
+
+  auto reload = [&] {
+    notify.reloading();
+    log->info("SIGHUP: reloading {}", config_path);
+    auto fresh = load_config_file(config_path);
+    if (!fresh.ok()) {
+      for (const auto& issue : fresh.issues) log->error("{}", issue.to_string());
+      log->error("reload refused: {} has {} error(s); the running configuration stays", config_path,
+                 fresh.issues.size());
+      notify.reloaded(session->status(host_now()));
+      return;
+    }
+    const Config old = session->config();
+    const SinkKey new_key = sink_key(fresh.config, can_log);
+    session.reset();
+    try {
+      if (!(new_key == key)) {
+        auto s = make_sink(new_key);
+        sink = std::move(s);
+        key = new_key;
+      }
+      session = open_session(fresh.config);
+      log->info("reloaded {}: starting again from STOP, starting up", config_path);
+    } catch (const std::exception& e) {
+      log->error("reload failed: {}; going back to the previous configuration", e.what());
+      session.reset();
+      session = open_session(old);
+    }
+    notify.reloaded(session->status(host_now()));
+  };
+
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
+  std::function<void()> wait_signal = [&] {
+    signals.async_wait([&](const boost::system::error_code& ec, int sig) {
+      if (ec) return;
+      if (sig == SIGHUP) {
+        try {
+          reload();
+        } catch (const std::exception& e) {
+          // Even the previous configuration could not be restarted (its port was taken meanwhile).
+          log->critical("reload: {}; exiting", e.what());
+          io.stop();
+          return;
+        }
+        wait_signal();
+        return;
+      }
+      log->info("{}: stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+      notify.stopping();
+      session->shutdown();
+      timer.cancel();
+      io.stop();
+    });
+  };
+  wait_signal();
+  io.run();
+
+  if (session) {
+    session->stop();
+    if (!args.has("quiet")) session->print_summary();
+  }
+  return kExitOk;
+}
+
+}  // namespace fieldguard::app

@@ -1,0 +1,100 @@
+// The daemon's output stage on a fake clock: decisions between rotations reach the bus at once.
+#include "app/run_stage.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "fieldguard/output/can_layout.hpp"
+
+namespace fieldguard::app {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+struct Sent {
+  output::CanFrame frame;
+  Stamp t;
+};
+
+class RecordingSink final : public output::CanSink {
+ public:
+  void write(std::span<const output::CanFrame> frames, Stamp t) override {
+    for (const auto& f : frames) sent.push_back({f, t});
+    stats_.sent += frames.size();
+  }
+  [[nodiscard]] const output::CanSinkStats& stats() const override { return stats_; }
+  std::vector<Sent> sent;
+
+ private:
+  output::CanSinkStats stats_;
+};
+
+struct LiveStageTest : ::testing::Test {
+  Config cfg;  // defaults: the 3D LiDAR required, timeout 0.3 s, 3 clear frames, heartbeat 100 ms
+  RecordingSink sink;
+  output::CanEncoder enc{cfg.can.params};
+  const std::int64_t t0 = 1'700'000'000'000 * kMs;
+
+  [[nodiscard]] std::vector<Sent> stops() const {
+    std::vector<Sent> out;
+    for (const auto& s : sink.sent) {
+      if (s.frame.id == enc.id_of(output::MessageId::StopRequest)) out.push_back(s);
+    }
+    return out;
+  }
+  static std::uint64_t sig(const Sent& s, std::size_t i) {
+    return output::get_raw(s.frame.data, output::layout(output::MessageId::StopRequest).signals[i]);
+  }
+};
+
+TEST_F(LiveStageTest, SilenceAfterGoStopsAtTheTimeoutWithoutARotation) {
+  LiveStage stage(cfg, sink);
+  stage.tick(Stamp{t0}, 0);
+  ASSERT_FALSE(stops().empty());
+  EXPECT_EQ(sig(stops().back(), output::stop_sig::Command), 1U);
+  EXPECT_EQ(sig(stops().back(), output::stop_sig::ReasonStartingUp), 1U);
+  // Four clear rotations, 100 ms apart, data to the end of each: GO after the clear frames.
+  perception::FrameResult nothing;
+  LidarFrame f;
+  std::int64_t t = t0;
+  for (int k = 0; k < 4; ++k) {
+    t = t0 + (k + 1) * 100 * kMs;
+    stage.sensor_data(output::safety::Sensor::Lidar, Stamp{t});
+    f.index = static_cast<std::uint64_t>(k);
+    stage.frame(f, nothing, Stamp{t}, Stamp{t + 20 * kMs}, 0);
+  }
+  ASSERT_TRUE(stage.started());
+  EXPECT_EQ(sig(stops().back(), output::stop_sig::Command), 0U);
+  const std::int64_t last_data = t;
+  // Ticks every 5 ms: GO while within the timeout, STOP (sensor fault) at the first tick past it, sent then.
+  std::size_t before = 0;
+  std::int64_t stop_at = 0;
+  for (std::int64_t now = last_data + 25 * kMs; now < last_data + 600 * kMs && stop_at == 0; now += 5 * kMs) {
+    before = stops().size();
+    if (stage.tick(Stamp{now}, 0).stop) stop_at = now;
+  }
+  ASSERT_NE(stop_at, 0);
+  EXPECT_GE(stop_at, last_data + 300 * kMs);  // the monitor counts a silence of exactly the timeout as too long
+  EXPECT_LE(stop_at, last_data + 305 * kMs);
+  ASSERT_GT(stops().size(), before);
+  const Sent s = stops().back();
+  EXPECT_EQ(s.t.ns, stop_at) << "not sent when decided";
+  EXPECT_EQ(sig(s, output::stop_sig::Command), 1U);
+  EXPECT_EQ(sig(s, output::stop_sig::ReasonSensorFault), 1U);
+  // The next cycle repeats it; an unchanged decision is not sent again between cycles.
+  const std::size_t n = stops().size();
+  stage.tick(Stamp{stop_at + 1 * kMs}, 0);
+  EXPECT_EQ(stops().size(), n);
+  stage.tick(Stamp{stop_at + 100 * kMs}, 0);
+  ASSERT_GT(stops().size(), n);
+  EXPECT_EQ(sig(stops().back(), output::stop_sig::ReasonSensorFault), 1U);
+  // The last word: STOP, shutting down; the log stays in time order.
+  stage.shutdown(Stamp{stop_at + 150 * kMs});
+  EXPECT_EQ(sig(stops().back(), output::stop_sig::Command), 1U);
+  EXPECT_EQ(sig(stops().back(), output::stop_sig::ReasonShuttingDown), 1U);
+  for (std::size_t i = 1; i < sink.sent.size(); ++i) EXPECT_LE(sink.sent[i - 1].t.ns, sink.sent[i].t.ns);
+}
+
+}  // namespace
+}  // namespace fieldguard::app
