@@ -45,10 +45,15 @@ output::StopRequest CanStage::request_for(const safety::Decision& d) {
 }
 
 output::Heartbeat CanStage::heartbeat(std::uint64_t frames_lost) const {
+  return heartbeat_for(cfg_.safety, last_, frames_lost);
+}
+
+output::Heartbeat CanStage::heartbeat_for(const safety::Params& safety,
+                                          const std::optional<safety::Decision>& last, std::uint64_t frames_lost) {
   auto health = [&](safety::Sensor s) {
-    if (!cfg_.safety.sensor(s).required) return output::SensorHealth::NotRequired;
-    if (!last_) return output::SensorHealth::Unknown;
-    const std::uint8_t bad = static_cast<std::uint8_t>(last_->fault_sensors | last_->implausible_sensors);
+    if (!safety.sensor(s).required) return output::SensorHealth::NotRequired;
+    if (!last) return output::SensorHealth::Unknown;
+    const std::uint8_t bad = static_cast<std::uint8_t>(last->fault_sensors | last->implausible_sensors);
     return (bad & safety::bit(s)) != 0 ? output::SensorHealth::Fault : output::SensorHealth::Ok;
   };
   output::Heartbeat h;

@@ -45,6 +45,10 @@ class CanStage {
 
   // The stop request for a decision: while a stop is held for clear frames its reason is the one that caused it.
   [[nodiscard]] static output::StopRequest request_for(const output::safety::Decision& d);
+  // The heartbeat's health bits for the latest decision (none yet: Unknown for each required sensor).
+  [[nodiscard]] static output::Heartbeat heartbeat_for(const output::safety::Params& safety,
+                                                       const std::optional<output::safety::Decision>& last,
+                                                       std::uint64_t frames_lost);
 
  private:
   [[nodiscard]] output::Heartbeat heartbeat(std::uint64_t frames_lost) const;

@@ -15,6 +15,7 @@
 #include "app/commands.hpp"
 #include "app/logging.hpp"
 #include "app/samples.hpp"
+#include "app/serial_options.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/io/pcap_writer.hpp"
@@ -41,18 +42,6 @@ constexpr const char* kHelp =
     "\n"
     "  --samples-out FILE  also decode live and write every sample as a JSON line (what replay --samples-out\n"
     "                      writes from the recording)\n";
-
-io::SerialOptions serial_options(const SerialConfig& c) {
-  io::SerialOptions o;
-  o.device = c.device;
-  o.baud = c.baud;
-  o.data_bits = c.data_bits;
-  o.parity = c.parity;
-  o.stop_bits = c.stop_bits;
-  o.silence_timeout_s = c.silence_timeout_s;
-  o.reopen_interval_s = c.reopen_interval_s;
-  return o;
-}
 
 }  // namespace
 

@@ -25,6 +25,7 @@
 #include "app/run_stage.hpp"
 #include "app/samples.hpp"
 #include "app/systemd_notify.hpp"
+#include "app/serial_options.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/scip_source.hpp"
@@ -105,18 +106,6 @@ std::unique_ptr<output::CanSink> make_sink(const SinkKey& k) {
     case CanSinkKind::None: break;
   }
   return std::make_unique<NullSink>();
-}
-
-io::SerialOptions serial_options(const SerialConfig& c) {
-  io::SerialOptions o;
-  o.device = c.device;
-  o.baud = c.baud;
-  o.data_bits = c.data_bits;
-  o.parity = c.parity;
-  o.stop_bits = c.stop_bits;
-  o.silence_timeout_s = c.silence_timeout_s;
-  o.reopen_interval_s = c.reopen_interval_s;
-  return o;
 }
 
 struct Job {

@@ -91,19 +91,7 @@ void LiveStage::shutdown(Stamp now) {
 }
 
 output::Heartbeat LiveStage::heartbeat(std::uint64_t frames_lost) const {
-  auto health = [&](safety::Sensor s) {
-    if (!cfg_.safety.sensor(s).required) return output::SensorHealth::NotRequired;
-    if (!last_) return output::SensorHealth::Unknown;
-    const std::uint8_t bad = static_cast<std::uint8_t>(last_->fault_sensors | last_->implausible_sensors);
-    return (bad & safety::bit(s)) != 0 ? output::SensorHealth::Fault : output::SensorHealth::Ok;
-  };
-  output::Heartbeat h;
-  h.lidar3d = health(safety::Sensor::Lidar);
-  h.lidar2d = health(safety::Sensor::Scan2d);
-  h.gnss = health(safety::Sensor::Gnss);
-  h.ahrs = health(safety::Sensor::Ahrs);
-  h.frames_lost = frames_lost;
-  return h;
+  return CanStage::heartbeat_for(cfg_.safety, last_, frames_lost);
 }
 
 }  // namespace fieldguard::app
