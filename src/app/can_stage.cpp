@@ -10,16 +10,12 @@ namespace {
 
 namespace safety = output::safety;
 
-Nanos period_of(double seconds) {
-  return std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(seconds));
-}
-
 }  // namespace
 
 CanStage::CanStage(const Config& cfg, output::CanSink& sink)
     : cfg_(cfg),
       encoder_(cfg.can.params),
-      schedule_(encoder_, sink, period_of(cfg.can.heartbeat_period_s)),
+      schedule_(encoder_, sink, nanos_from_seconds(cfg.can.heartbeat_period_s)),
       monitor_(cfg.safety) {}
 
 void CanStage::start(Stamp t) { schedule_.tick(t, heartbeat(0)); }

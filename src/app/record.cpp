@@ -15,7 +15,7 @@
 #include "app/commands.hpp"
 #include "app/logging.hpp"
 #include "app/samples.hpp"
-#include "app/serial_options.hpp"
+#include "app/source_options.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/io/pcap_writer.hpp"
@@ -114,15 +114,7 @@ int cmd_record(const std::vector<std::string>& argv) {
   std::unique_ptr<io::ScipSource> scip;
   if (cfg.scan2d.enabled) {
     scan_log = open_log("scan2d.log", "scan2d scip " + cfg.scan2d.host + ":" + std::to_string(cfg.scan2d.port));
-    io::ScipSourceOptions o;
-    o.tcp.host = cfg.scan2d.host;
-    o.tcp.port = cfg.scan2d.port;
-    o.tcp.connect_timeout_s = cfg.scan2d.connect_timeout_s;
-    o.tcp.silence_timeout_s = cfg.scan2d.silence_timeout_s;
-    o.tcp.backoff_max_s = cfg.scan2d.backoff_max_s;
-    o.client.scan.first_step = static_cast<std::uint16_t>(cfg.scan2d.start_step);
-    o.client.scan.last_step = static_cast<std::uint16_t>(cfg.scan2d.end_step);
-    o.client.intensity = cfg.scan2d.intensity;
+    const io::ScipSourceOptions o = scip_source_options(cfg.scan2d);
     scip = std::make_unique<io::ScipSource>(io, o, nullptr, [&](const std::string& w) { log->info("scan2d: {}", w); });
     scip->set_tap([&](ByteSpan b, bool to_sensor, Stamp t) {
       if (scan_log && !scan_log->write(t, to_sensor ? io::Direction::ToSensor : io::Direction::FromSensor, b)) ++write_failures;

@@ -25,7 +25,7 @@
 #include "app/run_stage.hpp"
 #include "app/samples.hpp"
 #include "app/systemd_notify.hpp"
-#include "app/serial_options.hpp"
+#include "app/source_options.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/scip_source.hpp"
@@ -66,10 +66,6 @@ constexpr const char* kHelp =
 
 constexpr auto kTick = std::chrono::milliseconds(5);
 constexpr auto kStatusEvery = std::chrono::seconds(1);
-
-Stamp host_now() {
-  return Stamp{std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count()};
-}
 
 // can.sink: none. Frames are counted and go nowhere.
 class NullSink final : public output::CanSink {
@@ -177,22 +173,14 @@ class Session {
 
   // Throws std::system_error when the LiDAR's port cannot be bound.
   void start() {
-    const Stamp now = host_now();
+    const Stamp now = wall_clock_now();
     io::UdpReceiverOptions o;
     o.port = cfg_.lidar.data_port;
     udp_ = std::make_unique<io::UdpReceiver>(io_, o, [this](const io::UdpDatagram& d) { on_datagram(d); });
     udp_->start();
     log_->info("listening for the 3D LiDAR on udp port {}", udp_->local_port());
     if (cfg_.scan2d.enabled) {
-      io::ScipSourceOptions so;
-      so.tcp.host = cfg_.scan2d.host;
-      so.tcp.port = cfg_.scan2d.port;
-      so.tcp.connect_timeout_s = cfg_.scan2d.connect_timeout_s;
-      so.tcp.silence_timeout_s = cfg_.scan2d.silence_timeout_s;
-      so.tcp.backoff_max_s = cfg_.scan2d.backoff_max_s;
-      so.client.scan.first_step = static_cast<std::uint16_t>(cfg_.scan2d.start_step);
-      so.client.scan.last_step = static_cast<std::uint16_t>(cfg_.scan2d.end_step);
-      so.client.intensity = cfg_.scan2d.intensity;
+      const io::ScipSourceOptions so = scip_source_options(cfg_.scan2d);
       scip_ = std::make_unique<io::ScipSource>(
           io_, so, [this](const scip::Scan&, const scip::Geometry&, Stamp t) { heard(safety::Sensor::Scan2d, t); },
           [this](const std::string& w) { log_->info("scan2d: {}", w); });
@@ -222,12 +210,12 @@ class Session {
     pool_.poll([this](const Pool::Result& r) { deliver(r); });
   }
 
-  void shutdown() { stage_.shutdown(host_now()); }
+  void shutdown() { stage_.shutdown(wall_clock_now()); }
 
   // The output timer: finished rotations in order, then a decision on the clock and the CAN cycles due.
   void on_tick() {
     pool_.poll([this](const Pool::Result& r) { deliver(r); });
-    const Stamp now = host_now();
+    const Stamp now = wall_clock_now();
     stage_.tick(now, lost_);
     // A decision on the clock is progress unless rotations are stuck in the pipeline: then the watchdog
     // starves and systemd restarts a daemon whose workers no longer work.
@@ -322,7 +310,7 @@ class Session {
       swap(job_.frame, f);
       job_.complete = d.host_time;
       if (pool_.submit(job_)) {
-        submitted_.push_back(host_now());
+        submitted_.push_back(wall_clock_now());
       } else {
         ++lost_;
       }
@@ -341,7 +329,7 @@ class Session {
       }
       return;
     }
-    stage_.frame(r.input->frame, *r.output, r.input->complete, host_now(), lost_);
+    stage_.frame(r.input->frame, *r.output, r.input->complete, wall_clock_now(), lost_);
     if (ready_) notify_.progress(SteadyClock::now());
   }
 
@@ -438,7 +426,7 @@ int cmd_run(const std::vector<std::string>& argv) {
       for (const auto& issue : fresh.issues) log->error("{}", issue.to_string());
       log->error("reload refused: {} has {} error(s); the running configuration stays", config_path,
                  fresh.issues.size());
-      notify.reloaded(session->status(host_now()));
+      notify.reloaded(session->status(wall_clock_now()));
       return;
     }
     const Config old = session->config();
@@ -457,7 +445,7 @@ int cmd_run(const std::vector<std::string>& argv) {
       session.reset();
       session = open_session(old);
     }
-    notify.reloaded(session->status(host_now()));
+    notify.reloaded(session->status(wall_clock_now()));
   };
 
   boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);

@@ -10,10 +10,6 @@ namespace {
 
 namespace safety = output::safety;
 
-Nanos period_of(double seconds) {
-  return std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(seconds));
-}
-
 }  // namespace
 
 bool same_request(const output::StopRequest& a, const output::StopRequest& b) {
@@ -25,7 +21,7 @@ bool same_request(const output::StopRequest& a, const output::StopRequest& b) {
 LiveStage::LiveStage(const Config& cfg, output::CanSink& sink)
     : cfg_(cfg),
       encoder_(cfg.can.params),
-      schedule_(encoder_, sink, period_of(cfg.can.heartbeat_period_s)),
+      schedule_(encoder_, sink, nanos_from_seconds(cfg.can.heartbeat_period_s)),
       monitor_(cfg.safety) {}
 
 void LiveStage::sensor_data(safety::Sensor s, Stamp t) {

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cstdint>
 
+#include "fieldguard/core/time.hpp"
+
 namespace fieldguard::io::detail {
 
 // Seconds from the configuration as a steady-clock duration, for timers.
@@ -12,9 +14,6 @@ namespace fieldguard::io::detail {
 }
 
 // Wall-clock receive time, in the project's Stamp unit (ns since the epoch).
-[[nodiscard]] inline std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+[[nodiscard]] inline std::int64_t now_ns() { return wall_clock_now().ns; }
 
 }  // namespace fieldguard::io::detail

@@ -8,9 +8,10 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
 #include <cerrno>
-#include <chrono>
 #include <cstring>
 #include <system_error>
+
+#include "fieldguard/core/time.hpp"
 
 namespace fieldguard::io {
 
@@ -70,8 +71,7 @@ struct UdpReceiver::Impl {
         }
       }
       if (rx_ns == 0) {
-        rx_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-                    .count();
+        rx_ns = wall_clock_now().ns;
       }
       if ((msg.msg_flags & MSG_TRUNC) != 0) {
         ++stats.truncated;

@@ -17,6 +17,16 @@ struct Stamp {
   friend auto operator<=>(const Stamp&, const Stamp&) = default;
 };
 
+// A duration from the configuration's seconds (heartbeat periods, timeouts), rounded toward zero to whole ns.
+[[nodiscard]] inline Nanos nanos_from_seconds(double seconds) {
+  return std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(seconds));
+}
+
+// The host's wall clock now, as a receive time.
+[[nodiscard]] inline Stamp wall_clock_now() {
+  return Stamp{std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count()};
+}
+
 struct SampleTimes {
   Stamp sensor;  // the sensor's own clock (mapped to UTC where possible)
   Stamp host;    // when the host received it
