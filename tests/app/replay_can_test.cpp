@@ -18,6 +18,7 @@
 
 #include "app/json_reader.hpp"
 #include "app/run_command.hpp"
+#include "app/sim_can_support.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/output/safety_params.hpp"
 #include "io/pcap_builder.hpp"
@@ -25,6 +26,11 @@
 
 namespace fieldguard {
 namespace {
+
+using testing::count_lines;
+using testing::LogFrame;
+using testing::read_candump;
+using testing::slurp;
 
 namespace fs = std::filesystem;
 using testing::run_fieldguard;
@@ -35,15 +41,6 @@ const std::string kConfig = kSource + "/config/fieldguard.yaml";
 const std::string kHdl = std::string(FIELDGUARD_TEST_DATA) + "/hdl32e_monterey_600.pcap";
 constexpr int kRotations = 60;  // 10 per crossing band: the pedestrian walks 1.6 m a rotation
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
-
 std::string replay(const std::string& config, const std::string& pcap, const std::string& extra) {
   return "replay --quiet --config '" + config + "' --pcap '" + pcap + "' " + extra;
 }
@@ -52,20 +49,18 @@ std::string replay(const std::string& config, const std::string& pcap, const std
 class SimCapture : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = std::make_unique<testing::TempDir>();
-    pcap_ = (dir_->path() / "ped.pcap").string();
-    truth_ = (dir_->path() / "ped.truth.jsonl").string();
-    const std::string cmd = std::string("'") + FIELDGUARD_SIM + "' --scene pedestrian --rotations " +
-                            std::to_string(kRotations) + " --quiet --pcap '" + pcap_ + "' --truth '" + truth_ + "'";
-    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    capture_ = std::make_unique<testing::PedestrianCapture>(kRotations);
+    ASSERT_TRUE(capture_->ok) << capture_->command;
+    pcap_ = capture_->pcap;
+    truth_ = capture_->truth;
   }
-  static void TearDownTestSuite() { dir_.reset(); }
+  static void TearDownTestSuite() { capture_.reset(); }
 
-  static std::unique_ptr<testing::TempDir> dir_;
+  static std::unique_ptr<testing::PedestrianCapture> capture_;
   static std::string pcap_;
   static std::string truth_;
 };
-std::unique_ptr<testing::TempDir> SimCapture::dir_;
+std::unique_ptr<testing::PedestrianCapture> SimCapture::capture_;
 std::string SimCapture::pcap_;
 std::string SimCapture::truth_;
 
@@ -150,40 +145,6 @@ TEST(ReplayCan, FailedLogWriteIsAFailure) {
   const auto r = run_fieldguard(replay(kConfig, kHdl, "--can-log /dev/full"));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("cannot write /dev/full"), std::string::npos) << r.output;
-}
-
-struct LogFrame {
-  long long us = 0;  // stamp, microseconds
-  std::string iface;
-  std::uint32_t id = 0;
-  std::vector<std::uint8_t> data;
-};
-
-// "(0000001700.123456) can0 18FF1080#010000000000053E"; fails the test on any other line.
-std::vector<LogFrame> read_candump(const std::string& text) {
-  std::vector<LogFrame> out;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) {
-    LogFrame f;
-    long long s = 0;
-    long long us = 0;
-    char iface[32] = {};
-    char id[16] = {};
-    char data[32] = {};
-    const int n = std::sscanf(line.c_str(), "(%lld.%lld) %31s %15[0-9A-F]#%31[0-9A-F]", &s, &us, iface, id, data);
-    EXPECT_EQ(n, 5) << "not a candump -L line: " << line;
-    if (n != 5) continue;
-    EXPECT_EQ(std::string(id).size(), 8U) << line;
-    f.us = s * 1000000 + us;
-    f.iface = iface;
-    f.id = static_cast<std::uint32_t>(std::stoul(id, nullptr, 16));
-    for (std::size_t i = 0; i + 1 < std::strlen(data); i += 2) {
-      f.data.push_back(static_cast<std::uint8_t>(std::stoul(std::string(data + i, 2), nullptr, 16)));
-    }
-    out.push_back(std::move(f));
-  }
-  return out;
 }
 
 struct Stop {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "app/json_reader.hpp"
+#include "app/sim_can_support.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/output/safety_params.hpp"
 #include "io/pcap_builder.hpp"
@@ -36,6 +37,11 @@
 
 namespace fieldguard {
 namespace {
+
+using testing::count_lines;
+using testing::LogFrame;
+using testing::read_candump;
+using testing::slurp;
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -45,13 +51,6 @@ const std::string kSource = FIELDGUARD_SOURCE_DIR;
 constexpr int kRotations = 120;  // 20 per crossing band: the pedestrian walks 0.8 m a rotation
 constexpr double kPeriod = 0.1;  // the simulator's 10 Hz (181 packets: 100.09 ms)
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // `text` with the first `from` replaced by `to`; fails the test when `from` is not there.
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
@@ -59,8 +58,6 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   if (at != std::string::npos) text.replace(at, from.size(), to);
   return text;
 }
-
-std::size_t count_lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
 
 // A UDP port nobody listens on now (the kernel's pick), for the daemon to bind.
 std::uint16_t free_udp_port() {
@@ -140,36 +137,6 @@ class Process {
   std::optional<int> status_;
 };
 
-struct LogFrame {
-  long long us = 0;
-  std::uint32_t id = 0;
-  std::vector<std::uint8_t> data;
-};
-
-std::vector<LogFrame> read_candump(const std::string& text) {
-  std::vector<LogFrame> out;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line)) {
-    long long s = 0;
-    long long us = 0;
-    char iface[32] = {};
-    char id[16] = {};
-    char data[32] = {};
-    const int n = std::sscanf(line.c_str(), "(%lld.%lld) %31s %15[0-9A-F]#%31[0-9A-F]", &s, &us, iface, id, data);
-    EXPECT_EQ(n, 5) << "not a candump -L line: " << line;
-    if (n != 5) continue;
-    LogFrame f;
-    f.us = s * 1000000 + us;
-    f.id = static_cast<std::uint32_t>(std::stoul(id, nullptr, 16));
-    for (std::size_t i = 0; i + 1 < std::strlen(data); i += 2) {
-      f.data.push_back(static_cast<std::uint8_t>(std::stoul(std::string(data + i, 2), nullptr, 16)));
-    }
-    out.push_back(std::move(f));
-  }
-  return out;
-}
-
 struct Stop {
   long long us = 0;
   int command = -1;
@@ -233,14 +200,12 @@ Decoded decode_log(const std::string& text) {
 class RunE2e : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = std::make_unique<testing::TempDir>();
-    pcap_ = (dir_->path() / "ped.pcap").string();
-    truth_ = (dir_->path() / "ped.truth.jsonl").string();
-    const std::string cmd = std::string("'") + FIELDGUARD_SIM + "' --scene pedestrian --rotations " +
-                            std::to_string(kRotations) + " --quiet --pcap '" + pcap_ + "' --truth '" + truth_ + "'";
-    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    capture_ = std::make_unique<testing::PedestrianCapture>(kRotations);
+    ASSERT_TRUE(capture_->ok) << capture_->command;
+    pcap_ = capture_->pcap;
+    truth_ = capture_->truth;
   }
-  static void TearDownTestSuite() { dir_.reset(); }
+  static void TearDownTestSuite() { capture_.reset(); }
 
   // The shipped configuration with the LiDAR on `port`, a candump log, a zone 0.6 m wide (each crossing
   // walks into it and out again), and two workers.
@@ -271,11 +236,11 @@ class RunE2e : public ::testing::Test {
   }
 
   testing::TempDir dir;
-  static std::unique_ptr<testing::TempDir> dir_;
+  static std::unique_ptr<testing::PedestrianCapture> capture_;
   static std::string pcap_;
   static std::string truth_;
 };
-std::unique_ptr<testing::TempDir> RunE2e::dir_;
+std::unique_ptr<testing::PedestrianCapture> RunE2e::capture_;
 std::string RunE2e::pcap_;
 std::string RunE2e::truth_;
 
