@@ -3,6 +3,9 @@
 // 0.2 s) into the level frame and into plane coordinates, and the lifting of a 1,081-step 2D scan.
 //   bench_geo [--benchmark_filter=...] [--benchmark_repetitions=5]
 // Deskew runs with exact per-point poses (pose_step_us 0) and with the default 100 us pose steps.
+// BM_CompensateFrame is the whole per-frame job (FrameCompensator::compensate): a 0.2 s frame of 69,504
+// points (32 lasers x 2,172 firings), 20 AHRS samples, 2 GGA fixes bracketing the window and a 1,081-step
+// scan, without and with plane output.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -13,6 +16,7 @@
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/geo/attitude.hpp"
 #include "fieldguard/geo/deskew.hpp"
+#include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/geo/pose_track.hpp"
 #include "fieldguard/geo/projection.hpp"
 #include "fieldguard/geo/scan_lift.hpp"
@@ -149,6 +153,74 @@ void BM_LiftScan(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 1081);
 }
 BENCHMARK(BM_LiftScan)->Unit(benchmark::kMicrosecond);
+
+sync::SyncedFrame frame_70k() {
+  sync::SyncedFrame f;
+  f.window_start = at_s(0.0);
+  f.window_end = at_s(0.2);
+  f.rotations = 1;
+  f.points.reserve(69504);
+  for (int firing = 0; firing < 2172; ++firing) {
+    const double az = 2.0 * std::numbers::pi * firing / 2172.0;
+    for (int l = 0; l < 32; ++l) {
+      const double el = (-30.67 + 1.33 * l) * std::numbers::pi / 180.0;
+      const double r = 5.0 + 40.0 * std::fabs(std::sin(3.0 * az + l));
+      LidarPoint p;
+      p.x = static_cast<float>(r * std::cos(el) * std::cos(az));
+      p.y = static_cast<float>(r * std::cos(el) * std::sin(az));
+      p.z = static_cast<float>(r * std::sin(el));
+      p.time_s = static_cast<float>(0.2 * (firing + l / 32.0) / 2172.0);
+      p.ring = static_cast<std::uint16_t>(l);
+      f.points.push_back(p);
+    }
+  }
+  for (int i = 0; i < 20; ++i) {
+    const double t = -0.0025 + 0.0105 * i;  // ~95 Hz over the window (the last 2.5 ms before its end)
+    xsens::MtData2 d;
+    d.euler_deg = xsens::Vec3{6.0 * std::sin(5.0 * t), 5.0 * std::sin(3.0 * t), 20.0};
+    f.ahrs.push_back(sync::TimedAttitude{at_s(t), at_s(t + 0.002), d});
+  }
+  for (int i = 0; i < 2; ++i) {
+    nmea::Gga g;
+    g.lat_deg = 39.9 + 1e-6 * i;
+    g.lon_deg = 116.4;
+    g.quality = 4;
+    g.alt_m = 45.0;
+    g.geoid_sep_m = -8.5;
+    const double t = -0.05 + 0.3 * i;
+    f.gnss.push_back(sync::TimedGnss{at_s(t), at_s(t + 0.03), g});
+  }
+  sync::TimedScan s;
+  s.time = at_s(0.09);
+  s.scan.first_step = 0;
+  s.scan.last_step = 1080;
+  for (int i = 0; i <= 1080; ++i) s.scan.ranges_mm.push_back(static_cast<std::uint32_t>(1000 + 7 * i));
+  f.scan2d = s;
+  return f;
+}
+
+void BM_CompensateFrame(benchmark::State& state) {
+  const sync::SyncedFrame f = frame_70k();
+  CompensationParams p;
+  p.lidar.x_m = 1.8;
+  p.lidar.z_m = 2.2;
+  p.scanner.x_m = 2.0;
+  p.scanner.pitch_deg = 10.0;
+  p.antenna_m = Eigen::Vector3d(0.4, 0.0, 2.8);
+  p.plane_points = state.range(0) != 0;
+  const FrameCompensator comp(p);
+  CompensatedFrame out;
+  for (auto _ : state) {
+    comp.compensate(f, out);
+    benchmark::DoNotOptimize(out.points.data());
+  }
+  if (out.levelling != Levelling::Full || out.points.size() != f.points.size() + 1081) {
+    state.SkipWithError("the frame was not fully compensated: the benchmark measures the wrong path");
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(f.points.size() + 1081));
+  state.counters["points"] = static_cast<double>(out.points.size());
+}
+BENCHMARK(BM_CompensateFrame)->ArgName("plane_points")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

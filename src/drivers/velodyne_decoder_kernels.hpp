@@ -117,19 +117,19 @@ inline void transpose4(Vec4f& a, Vec4f& b, Vec4f& c, Vec4f& d) {
 }
 
 // A LidarPoint is written as two 16-byte halves: (x, y, z, intensity) and (time_s, range_m, w2, w3), where w2 and
-// w3 are the 32-bit words holding (azimuth_cdeg, ring) and (return_type, reserved0, reserved1).
+// w3 are the 32-bit words holding (azimuth_cdeg, ring) and (return_type, source, reserved1).
 static_assert(offsetof(LidarPoint, x) == 0 && offsetof(LidarPoint, y) == 4 && offsetof(LidarPoint, z) == 8 &&
               offsetof(LidarPoint, intensity) == 12 && offsetof(LidarPoint, time_s) == 16 &&
               offsetof(LidarPoint, range_m) == 20 && offsetof(LidarPoint, azimuth_cdeg) == 24 &&
               offsetof(LidarPoint, ring) == 26 && offsetof(LidarPoint, return_type) == 28 &&
-              offsetof(LidarPoint, reserved0) == 29 && offsetof(LidarPoint, reserved1) == 30 &&
+              offsetof(LidarPoint, source) == 29 && offsetof(LidarPoint, reserved1) == 30 &&
               sizeof(LidarPoint) == 32 && std::is_trivially_copyable_v<LidarPoint>);
 
 constexpr std::uint32_t azimuth_ring_word(std::uint16_t azimuth_cdeg, std::uint16_t ring) {
   if constexpr (std::endian::native == std::endian::little) return azimuth_cdeg | (std::uint32_t{ring} << 16);
   return (std::uint32_t{azimuth_cdeg} << 16) | ring;
 }
-constexpr std::uint32_t return_type_word(ReturnType type) {  // reserved0 = reserved1 = 0
+constexpr std::uint32_t return_type_word(ReturnType type) {  // source = reserved1 = 0
   const auto t = static_cast<std::uint32_t>(type);
   if constexpr (std::endian::native == std::endian::little) return t;
   return t << 24;

@@ -48,7 +48,7 @@ void expect_same_points(const std::vector<LidarPoint>& fast, const std::vector<L
     ASSERT_EQ(a.azimuth_cdeg, b.azimuth_cdeg) << what << " point " << i;
     ASSERT_EQ(a.ring, b.ring) << what << " point " << i;
     ASSERT_EQ(a.return_type, b.return_type) << what << " point " << i;
-    ASSERT_EQ(a.reserved0, 0);
+    ASSERT_EQ(a.source, 0);
     ASSERT_EQ(a.reserved1, 0);
     const double d = std::hypot(static_cast<double>(a.x) - static_cast<double>(b.x),
                                 static_cast<double>(a.y) - static_cast<double>(b.y));

@@ -8,6 +8,10 @@
 
 namespace fieldguard {
 
+// Which sensor measured a point of a merged frame (geo/frame_compensator.hpp lifts the 2D LiDAR's scan into
+// the 3D LiDAR's frame, each point marked).
+enum class PointSource : std::uint8_t { Lidar3d = 0, Lidar2d = 1 };
+
 enum class ReturnType : std::uint8_t { Strongest = 1, Last = 2, StrongestAndLast = 3, SecondStrongest = 4 };
 
 // Sensor frame of REP-103: x forward (azimuth 0), y left, z up, metres.
@@ -21,7 +25,7 @@ struct LidarPoint {
   std::uint16_t azimuth_cdeg = 0;   // azimuth of the firing, 0.01 degree, clockwise from x
   std::uint16_t ring = 0;           // laser ring, 0 = lowest beam
   ReturnType return_type = ReturnType::Strongest;
-  std::uint8_t reserved0 = 0;
+  std::uint8_t source = 0;          // PointSource: which sensor measured it (a decoder writes 3D LiDAR)
   std::uint16_t reserved1 = 0;
 };
 static_assert(sizeof(LidarPoint) == 32, "LidarPoint is a plain 32-byte record");

@@ -4,9 +4,9 @@
 
 #include <cstdint>
 
-namespace fieldguard::geo {
+#include "fieldguard/core/lidar_point.hpp"  // PointSource
 
-enum class PointSource : std::uint8_t { Lidar3d = 0, Lidar2d = 1 };
+namespace fieldguard::geo {
 
 struct SourcedPoint {
   float x = 0.F;  // m, in the frame the producing function names
