@@ -65,14 +65,87 @@ TEST(TransverseMercatorPublished, PoleOnWgs84WithUnitScale) {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// Control point with published Gauss-Krueger coordinates. The textbook example of Chinese geodesy courses
+// Control point from an authoritative publication, with the projection parameters stated:
+//   IOGP, Geomatics Guidance Note 7, part 2, "Coordinate Conversions and Transformations including Formulas",
+//   IOGP Publication 373-7-2, revision of September 2019, section "Transverse Mercator (South Orientated)"
+//   (EPSG coordinate operation method code 9808; section 1.3.5.3 in the November 2010 revision), worked
+//   example "Hartebeesthoek94 / Lo29" (EPSG CRS 2053). From epsg.org (Support documentation / Guidance notes)
+//   and
+//   https://www.iogp.org/bookstore/product/coordinate-conversions-and-transformation-including-formulas/
+// Parameters: WGS 84 ellipsoid (a = 6378137 m, 1/f = 298.257223563), latitude of natural origin 0,
+// longitude of natural origin 29 E, scale factor at natural origin 1, false easting = false northing = 0:
+// exactly Gauss-Krueger's transverse Mercator (scale 1 on the central meridian, origin on the equator) on an
+// ellipsoid we support, only with axes pointing west and south.
+// Point: latitude 25 deg 43' 55.302" S = -0.449108618 rad, longitude 28 deg 16' 57.479" E = 0.493625066 rad
+//   -> westing W = 71 984.49 m, southing S = 2 847 342.74 m.
+// The example computes from the radians; its DMS are those radians rounded to 0.001" (~3 cm), so the
+// radians are the input here (the DMS give W = 71 984.4797: some reproductions quote 71 984.48).
+// Tolerances are the example's printed precision: plane coordinates to 0.01 m, so 5 mm forward; reverse,
+// 1e-7 deg (~1 cm), the cm rounding of W and S plus the 1e-9 rad rounding of the radians.
+// Measured (this code, GeographicLib's TransverseMercatorProj exact and series, and PROJ 9.1 tmerc all agree
+// to 1e-6 m): W = 71 984.4909, S = 2 847 342.7376; reverse lat -0.4491086184 rad, lon 0.4936250662 rad.
+
+constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+constexpr double kIogpLo29LatDeg = -0.449108618 * kRadToDeg;
+constexpr double kIogpLo29LonDeg = 0.493625066 * kRadToDeg;
+constexpr double kIogpLo29Westing = 71984.49;
+constexpr double kIogpLo29Southing = 2847342.74;
+constexpr double kIogpPlaneTol = 0.005;     // half the published 0.01 m
+constexpr double kIogpLatLonTolDeg = 1e-7;  // see above
+
+TEST(GaussKruegerControlPoint, IogpGuidanceNote7_2_Sep2019_TmSouthOrientatedLo29_OnTheCore) {
+  // The example as published: central meridian 29 E, straight on the transverse Mercator GaussKrueger uses.
+  const detail::TransverseMercator tm(6378137.0, 1.0 / 298.257223563, 1.0);
+  const detail::TmXY f = tm.forward(29.0, kIogpLo29LatDeg, kIogpLo29LonDeg);
+  // Westing is minus the easting offset, southing minus the northing.
+  EXPECT_NEAR(-f.x_m, kIogpLo29Westing, kIogpPlaneTol) << "IOGP 373-7-2 (2019) Lo29 example, westing";
+  EXPECT_NEAR(-f.y_m, kIogpLo29Southing, kIogpPlaneTol) << "IOGP 373-7-2 (2019) Lo29 example, southing";
+  const detail::TmLatLon r = tm.reverse(29.0, -kIogpLo29Westing, -kIogpLo29Southing);
+  EXPECT_NEAR(r.lat_deg, kIogpLo29LatDeg, kIogpLatLonTolDeg) << "IOGP 373-7-2 (2019) Lo29 example, reverse";
+  EXPECT_NEAR(r.lon_deg, kIogpLo29LonDeg, kIogpLatLonTolDeg) << "IOGP 373-7-2 (2019) Lo29 example, reverse";
+}
+
+TEST(GaussKruegerControlPoint, IogpGuidanceNote7_2_Sep2019_TmSouthOrientatedLo29_ThroughGaussKrueger) {
+  // GaussKrueger's central meridians are multiples of 3 degrees, so 29 E is not one of them. The ellipsoid is
+  // symmetric about its axis, so the projection depends on longitude only through lon - lon0: the same point
+  // moved 2 degrees west, seen from CM 27 E (3-degree zone 9, 6-degree zone 5), has the published plane
+  // coordinates. This checks zone choice, false easting, zone prefix and the southern-hemisphere signs.
+  const Geodetic moved{kIogpLo29LatDeg, kIogpLo29LonDeg - 2.0, 7.0};
+  for (const auto& [width, zone] : {std::pair{ZoneWidth::Three, 9}, std::pair{ZoneWidth::Six, 5}}) {
+    ProjectionParams p;
+    p.ellipsoid = Ellipsoid::Wgs84;
+    p.zone_width = width;
+    p.zone_prefix = true;
+    const GaussKrueger gk(p);
+    const auto f = gk.forward(moved);
+    ASSERT_TRUE(f.has_value());
+    const std::string what = "IOGP 373-7-2 (2019) Lo29 example, width " + std::to_string(static_cast<int>(width));
+    EXPECT_EQ(f->zone, zone) << what;
+    EXPECT_DOUBLE_EQ(central_meridian_deg(zone, width), 27.0) << what;
+    EXPECT_NEAR(f->easting_m, zone * 1e6 + 500000.0 - kIogpLo29Westing, kIogpPlaneTol) << what;
+    EXPECT_NEAR(f->northing_m, -kIogpLo29Southing, kIogpPlaneTol) << what;
+    EXPECT_EQ(f->up_m, 7.0);
+
+    // Reverse from the published (rounded) coordinates, zone taken from the prefix.
+    const auto r = gk.reverse({-kIogpLo29Southing, zone * 1e6 + 500000.0 - kIogpLo29Westing, 7.0, 0});
+    ASSERT_TRUE(r.has_value()) << what;
+    EXPECT_NEAR(r->lat_deg, moved.lat_deg, kIogpLatLonTolDeg) << what;
+    EXPECT_NEAR(r->lon_deg, moved.lon_deg, kIogpLatLonTolDeg) << what;
+    EXPECT_EQ(r->h_m, 7.0);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// A Gauss-Krueger example on Krasovsky 1940 with the zone prefix, which the IOGP example above cannot cover
+// (its ellipsoid is WGS 84, its zone unprefixed). It is the textbook example of Chinese geodesy courses
 // (Beijing 1954 / Krasovsky 1940, 6-degree zone 20, CM 117 E): B = 30 deg 30', L = 114 deg 20' ->
-// x = 3 378 627.24 m, y = 20 243 953.41 m (zone prefixed). Found reproduced by two independent public
-// projects, which disagree with each other by 0.3 mm (their series are truncated differently):
+// x = 3 378 627.24 m, y = 20 243 953.41 m (zone prefixed). Not from an authoritative publication: it was
+// found only as reproduced by two public projects, which disagree with each other by 0.3 mm (their series
+// are truncated differently):
 //   apkpai/GaussProjection, README.md: "30°30′00″、114°20′00″" -> "3378627.239402275,243953.4126210633"
 //   q1310546582/CRSTrans, CoordTransformAlgorithms/Algorithms/TransToEllipseBLFromEllipseXY.py:
 //     "band:20 GCS: Beijing1954 interval: 6" -> (3378627.23968484, 20243953.4127856)
-// Not an official control-point register (none was found); held to 1 mm.
+// No Chinese standard or survey-office register with a worked point was found; held to 1 mm.
 TEST(GaussKruegerControlPoint, Beijing1954SixDegreeZone20) {
   ProjectionParams p;
   p.ellipsoid = Ellipsoid::Krasovsky1940;
