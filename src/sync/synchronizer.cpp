@@ -130,9 +130,23 @@ void Synchronizer::push_gnss(nmea::Sentence&& sentence, Stamp host) {
         u.seed_base(nearest_period_start(ns_of_day, kDayNs, host.ns));
       }
     }
-    const Mapping m = gnss_clock_.observe_raw(static_cast<std::uint64_t>(ns_of_day), host);
+    const std::int64_t sensor_ns = u.unwrap_ns(static_cast<std::uint64_t>(ns_of_day));
+    const Mapping m = gnss_clock_.model().observe(sensor_ns, host);
     note(SensorKind::Gnss, m, host);
     time = m.mapped;
+    // A PPS-synchronised 3D LiDAR keeps UTC too, and its packets reach the host within a millisecond: its
+    // model maps UTC onto the host clock without the receiver's output latency (tens of ms after the epoch,
+    // unknown, which the GNSS's own lower envelope would add to every fix and so shift every position back
+    // along the track by speed x latency).
+    // Only while the two agree to within a receiver's latency: a LiDAR without PPS counts from its power-on.
+    if (params_.gnss_utc_via_lidar && lidar_clock_.model().has_model()) {
+      const Stamp via = lidar_clock_.model().map(sensor_ns);
+      const double latency_s = static_cast<double>(m.mapped.ns - via.ns) * 1e-9;
+      if (latency_s > -0.05 && latency_s < params_.max_gnss_latency_s) {
+        time = via;
+        ++gnss_via_lidar_;
+      }
+    }
     last_fix_time_ = time;
     last_fix_host_ = host;
   } else {

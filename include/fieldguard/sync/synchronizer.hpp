@@ -30,6 +30,13 @@ struct SyncParams {
     return p;
   }();
   ClockParams ahrs_clock;
+  // A 3D LiDAR PPS-synchronised to the GNSS receiver keeps UTC in its packets: GNSS epochs are then mapped
+  // through the LiDAR's clock model, so a fix and a point of the same UTC instant get the same host time.
+  // Used only while the two models agree within max_gnss_latency_s (a LiDAR without PPS counts from its
+  // power-on and never agrees); otherwise, or false, each epoch is mapped by the GNSS's own model, and the
+  // receiver's output latency then counts as transport delay.
+  bool gnss_utc_via_lidar = true;
+  double max_gnss_latency_s = 0.3;
   double rate_window_s = 2.0;
   double untimed_pairing_s = 0.5;  // VTG/HDT/THS take the time of a fix received at most this long before
   // A window waiting for a sensor is normal for a moment (the GNSS fix after the window comes up to a fix period
@@ -60,6 +67,8 @@ class Synchronizer {
   [[nodiscard]] const HealthMonitor& health() const { return health_; }
   [[nodiscard]] const FrameAssembler& assembler() const { return assembler_; }
   [[nodiscard]] const SensorClock& clock(SensorKind k) const;
+  // GNSS epochs mapped through the LiDAR's clock (gnss_utc_via_lidar).
+  [[nodiscard]] std::uint64_t gnss_via_lidar() const { return gnss_via_lidar_; }
 
  private:
   SensorClock& clock_of(SensorKind k);
@@ -74,6 +83,7 @@ class Synchronizer {
   SensorClock ahrs_clock_;
   std::optional<Stamp> last_fix_time_;  // mapped time of the last timed NMEA sentence
   std::optional<Stamp> last_fix_host_;
+  std::uint64_t gnss_via_lidar_ = 0;
 };
 
 }  // namespace fieldguard::sync
