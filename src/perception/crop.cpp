@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "perception/simd.hpp"
 
@@ -33,9 +34,10 @@ struct BoxBounds {
 // for n), in order, and returns how many. Branch-free: every point is written at the next free place, which
 // moves on only when the point is kept, so the ROI's edge cutting through a rotation costs no mispredictions.
 // `keep` must be finite (it then rejects NaN and infinity); with `check_finite` the points are also tested.
-template <bool check_finite>
+// With `split`, the 2D LiDAR's points are not kept but appended to `scan2d` (a rare, well-predicted branch).
+template <bool check_finite, bool split>
 inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBounds& keep, const BoxBounds& drop,
-                               float* x, float* y, float* z, std::uint16_t* ring) {
+                               float* x, float* y, float* z, std::uint16_t* ring, std::vector<LidarPoint>* scan2d) {
   static_assert(offsetof(LidarPoint, x) == 0 && offsetof(LidarPoint, y) == 4 && offsetof(LidarPoint, z) == 8 &&
                 offsetof(LidarPoint, intensity) == 12);
   std::size_t k = 0;
@@ -44,6 +46,13 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
     const simd::f32x4 v = simd::load(&p.x);  // x, y, z, intensity
     bool kept = keep.contains(v) && !drop.contains(v);
     if constexpr (check_finite) kept = kept && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    if constexpr (split) {
+      const bool is_2d = p.source == static_cast<std::uint8_t>(PointSource::Lidar2d);
+      if (is_2d) [[unlikely]] {
+        scan2d->push_back(p);
+      }
+      kept = kept && !is_2d;
+    }
     x[k] = p.x;
     y[k] = p.y;
     z[k] = p.z;
@@ -55,7 +64,11 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
 
 }  // namespace
 
-void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out) {
+namespace {
+
+template <bool split>
+void crop(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
+          std::vector<LidarPoint>* scan2d) {
   const std::size_t n = in.size();
   out.x.resize(n);
   out.y.resize(n);
@@ -63,14 +76,26 @@ void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body,
   out.ring.resize(n);
   const BoxBounds keep(roi), drop(body);
   // A finite ROI already rejects NaN and infinity; only an unbounded one needs the explicit test.
-  const std::size_t k =
-      is_finite(roi)
-          ? crop_points<false>(in.data(), n, keep, drop, out.x.data(), out.y.data(), out.z.data(), out.ring.data())
-          : crop_points<true>(in.data(), n, keep, drop, out.x.data(), out.y.data(), out.z.data(), out.ring.data());
+  const std::size_t k = is_finite(roi) ? crop_points<false, split>(in.data(), n, keep, drop, out.x.data(), out.y.data(),
+                                                                   out.z.data(), out.ring.data(), scan2d)
+                                       : crop_points<true, split>(in.data(), n, keep, drop, out.x.data(), out.y.data(),
+                                                                  out.z.data(), out.ring.data(), scan2d);
   out.x.resize(k);
   out.y.resize(k);
   out.z.resize(k);
   out.ring.resize(k);
+}
+
+}  // namespace
+
+void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out) {
+  crop<false>(in, roi, body, out, nullptr);
+}
+
+void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
+              std::vector<LidarPoint>& scan2d) {
+  scan2d.clear();
+  crop<true>(in, roi, body, out, &scan2d);
 }
 
 }  // namespace fieldguard::perception

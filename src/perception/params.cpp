@@ -20,6 +20,8 @@ PipelineParams published_params() {
   p.filters.max_volume_m3 = 1.2;
   p.filters.min_height_m = 0.0;
   p.filters.min_points_full_range_m = 0.0;
+  // The published method had no 2D LiDAR: 2D points of a merged frame are left out of it entirely.
+  p.near_field.enabled = false;
   return p;
 }
 

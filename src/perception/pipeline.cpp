@@ -10,6 +10,7 @@
 #include "fieldguard/perception/cluster_filter.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
+#include "fieldguard/perception/near_field.hpp"
 #include "fieldguard/perception/obstacle_box.hpp"
 #include "fieldguard/perception/ransac_ground.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
@@ -18,7 +19,7 @@
 namespace fieldguard::perception {
 
 struct Pipeline::Impl {
-  explicit Impl(const PipelineParams& p) : params(p), voxel(p.voxel), clusterer(p.cluster) {
+  explicit Impl(const PipelineParams& p) : params(p), voxel(p.voxel), clusterer(p.cluster), near(p.near_field) {
     if (p.roi.min[0] >= p.roi.max[0] || p.roi.min[1] >= p.roi.max[1] || p.roi.min[2] >= p.roi.max[2]) {
       throw std::invalid_argument("Pipeline: the ROI box needs min < max on every axis");
     }
@@ -34,6 +35,7 @@ struct Pipeline::Impl {
   std::optional<RansacGround> ransac;
   std::optional<ZoneGround> zones;
   EuclideanClusterer clusterer;
+  NearField near;
 
   Cloud cropped, voxels, above;
   GroundLabels ground;
@@ -44,6 +46,7 @@ struct Pipeline::Impl {
   std::vector<LabeledPoint> labeled;
   std::vector<std::array<float, 2>> footprint, hull;
   HullScratch hull_scratch;
+  std::vector<LidarPoint> points2d;  // a merged frame's 2D LiDAR points
 };
 
 Pipeline::Pipeline(const PipelineParams& params) : impl_(std::make_unique<Impl>(params)) {}
@@ -62,11 +65,11 @@ float Pipeline::ground_z(float x, float y) const {
 FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   Impl& m = *impl_;
   FrameResult result;
-  result.counts.input = static_cast<std::uint32_t>(points.size());
-
   // ROI and body box, then the voxel grid. (One pass doing both measured no faster: the cropped cloud stays
-  // in cache between the two.)
-  crop_box(points, m.params.roi, m.params.body, m.cropped);
+  // in cache between the two.) A merged frame's 2D LiDAR points go to the near-field stage only (its one plane
+  // of points would be ground, or too few and too low for the 3D filters): the crop sets them aside.
+  crop_box(points, m.params.roi, m.params.body, m.cropped, m.points2d);
+  result.counts.input = static_cast<std::uint32_t>(points.size() - m.points2d.size());
   result.counts.after_roi = static_cast<std::uint32_t>(m.cropped.size());
   m.voxel.filter(m.cropped, m.voxels);
   const std::size_t n = m.voxels.size();
@@ -150,6 +153,17 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
     result.obstacles.push_back(o);
   }
   result.counts.obstacles = static_cast<std::uint32_t>(result.obstacles.size());
+
+  result.counts.near_input = static_cast<std::uint32_t>(m.points2d.size());
+  if (m.params.near_field.enabled && !m.points2d.empty()) {
+    // Against the ground this frame's 3D points just gave.
+    const NearField::Counts nc = m.near.detect(
+        m.points2d, [this](float x, float y) { return ground_z(x, y); }, result.obstacles);
+    result.counts.near_in_zone = nc.in_zone;
+    result.counts.near_obstacles = nc.obstacles;
+    result.counts.near_merged =
+        m.near.fuse(result.obstacles, result.counts.obstacles, static_cast<float>(m.params.cluster.tolerance_m));
+  }
 
   std::sort(result.obstacles.begin(), result.obstacles.end(), [](const Obstacle& a, const Obstacle& b) {
     if (a.distance_m != b.distance_m) return a.distance_m < b.distance_m;

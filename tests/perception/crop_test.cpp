@@ -66,5 +66,41 @@ TEST(CropBox, EmptyInputAndEverythingInTheBody) {
   EXPECT_TRUE(out.ring.empty());
 }
 
+// A merged frame: the 2D LiDAR's points go aside, all of them (inside the body box, outside the ROI, NaN), in
+// order; the 3D points crop as in a frame without them.
+TEST(CropBox, SetsTheScanOfAMergedFrameAside) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<LidarPoint> in, only3d;
+  for (int i = 0; i < 40; ++i) {
+    const float f = static_cast<float>(i);
+    LidarPoint p = lidar_point(-8.F + 0.9F * f, -5.F + 0.3F * f, -1.F + 0.05F * f, static_cast<std::uint16_t>(i));
+    if (i % 3 == 0) {
+      p.source = static_cast<std::uint8_t>(PointSource::Lidar2d);
+      if (i == 9) p.x = nan;
+      if (i == 12) p.x = 100.F;  // beyond the ROI
+      in.push_back(p);
+    } else {
+      in.push_back(p);
+      only3d.push_back(p);
+    }
+  }
+  in.push_back(lidar_point(0, 0, 0, 77));  // in the body box
+  in.back().source = static_cast<std::uint8_t>(PointSource::Lidar2d);
+  Cloud out, expected;
+  std::vector<LidarPoint> scan = {lidar_point(1, 2, 3)};  // stale content is replaced
+  crop_box(in, kRoi, kBody, out, scan);
+  crop_box(only3d, kRoi, kBody, expected);
+  EXPECT_EQ(std::vector<float>(out.x.begin(), out.x.end()), std::vector<float>(expected.x.begin(), expected.x.end()));
+  EXPECT_EQ(std::vector<std::uint16_t>(out.ring.begin(), out.ring.end()),
+            std::vector<std::uint16_t>(expected.ring.begin(), expected.ring.end()));
+  ASSERT_EQ(scan.size(), 15U);
+  for (std::size_t i = 0; i + 1 < scan.size(); ++i) EXPECT_EQ(scan[i].ring, 3 * i);
+  EXPECT_EQ(scan.back().ring, 77U);
+  // Without a 2D point the overload is the plain crop.
+  crop_box(only3d, kRoi, kBody, out, scan);
+  EXPECT_TRUE(scan.empty());
+  EXPECT_EQ(out.size(), expected.size());
+}
+
 }  // namespace
 }  // namespace fieldguard::perception

@@ -3,6 +3,7 @@
 // that shrinks the data most.
 
 #include <span>
+#include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/perception/cloud.hpp"
@@ -14,5 +15,10 @@ namespace fieldguard::perception {
 // Boxes are closed, as pcl::CropBox's: a point on a face of the ROI is kept, one on a face of the body box
 // is removed. NaN and infinite coordinates are dropped.
 void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out);
+
+// The same for the 3D LiDAR's points of a merged frame; the 2D LiDAR's (LidarPoint::source Lidar2d) go to
+// `scan2d` instead (cleared first), all of them, in input order: in one pass, not a copy of the frame.
+void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
+              std::vector<LidarPoint>& scan2d);
 
 }  // namespace fieldguard::perception

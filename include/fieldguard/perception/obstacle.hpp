@@ -9,6 +9,11 @@
 
 namespace fieldguard::perception {
 
+// Which sensors saw an obstacle (Obstacle::sources, a bit mask): the 3D LiDAR's clusters, the 2D LiDAR's
+// near-field segments (near_field.hpp), or both when a segment was merged into a cluster.
+inline constexpr std::uint8_t kSeenBy3d = 1U;  // bit 0
+inline constexpr std::uint8_t kSeenBy2d = 2U;  // bit 1
+
 // small: person-sized (fits in 1.2 m x 1.2 m x 2.2 m); large: implement, haystack, building, tree.
 enum class SizeClass : std::uint8_t { Small = 0, Large = 1 };
 [[nodiscard]] std::string_view to_string(SizeClass c);
@@ -26,6 +31,7 @@ struct Obstacle {
   float bearing_deg = 0.F;            // atan2(y, x) of the box centre, degrees, + to the left
   float height_above_ground_m = 0.F;  // highest point above the local ground under the cluster
   SizeClass size_class = SizeClass::Small;
+  std::uint8_t sources = kSeenBy3d;   // kSeenBy3d | kSeenBy2d: which sensors' points it holds
 };
 
 // Points of the processed frame with what the pipeline made of them, for pictures and debugging.
@@ -45,6 +51,12 @@ struct StageCounts {
   std::uint32_t ground = 0;
   std::uint32_t clusters = 0;     // before the filters
   std::uint32_t obstacles = 0;    // after the filters
+  // The 2D LiDAR's near-field path (near_field.hpp); none of its points is counted above. Obstacles
+  // reported = obstacles + near_obstacles - near_merged.
+  std::uint32_t near_input = 0;      // 2D LiDAR points in the frame
+  std::uint32_t near_in_zone = 0;    // of them, finite and inside the near zone
+  std::uint32_t near_obstacles = 0;  // segments kept as obstacles
+  std::uint32_t near_merged = 0;     // of them, merged into a 3D obstacle they overlap
 };
 
 struct FrameResult {

@@ -100,6 +100,31 @@ struct FilterParams {
   int min_points_floor = 2;
 };
 
+// The 2D LiDAR's near field (near_field.hpp): the scan points of a merged frame become obstacles of their own,
+// because a low box in the 3D LiDAR's blind zone in front of the tractor gives the 3D path nothing.
+struct NearFieldParams {
+  bool enabled = true;  // acts only on frames that carry 2D points
+  // Where 2D points count, in the 3D LiDAR's levelled frame (m). x from the tractor's front (body max x):
+  // behind it the scan's outer rays, swinging back past +-90 deg, hit the tractor's own wheels and weights.
+  // x to 12 m: the stop zone at 20 km/h (2.8 m reaction, 5.2 m braking on friction 0.3, 1 m margin) fits,
+  // and farther out a residual pitch of 1 deg moves the scan plane 0.2 m, most of its height above ground.
+  // |y| 4 m: the stop zone's half width (2 m) and as much again for turns. z -3 .. 1 m: the ground lies near
+  // -sensor_height (0.95 .. 1.8 m); room for ditches below and rising ground above.
+  Box3 zone{{0.4, -4.0, -3.0}, {12.0, 4.0, 1.0}};
+  // Consecutive scan points nearer than this are one segment. At 0.25 deg a step, rays are 4 cm apart at
+  // 10 m, a surface seen at 10 deg grazing spreads them to 0.25 m; two objects less than this apart are one.
+  double max_gap_m = 0.3;
+  // A segment needs this many points standing min_height_m above the ground: dust, rain and a single crop
+  // stalk give one or two; a 0.1 m post at 12 m still gives 2 (0.48 deg), a leg at 8 m 3-4.
+  int min_points = 3;
+  // A scan point less than this above the local ground is ground (ground hits when the nose pitches down,
+  // clods, furrows) and is left out. The scan plane runs 0.3-0.45 m above flat ground, so what it hits stands
+  // that high: half of it leaves room for clods (< 0.1 m) plus the ground estimate's error below, and for a
+  // pitch error of 1.5 deg at 6 m above. Ploughed ridges (0.2-0.3 m over the furrows the ground plane
+  // follows) need more: raise it to 0.25 there.
+  double min_height_m = 0.15;
+};
+
 struct PipelineParams {
   VoxelParams voxel;
   Box3 roi{{-10.0, -10.0, -1.5}, {50.0, 10.0, 6.0}};
@@ -107,6 +132,7 @@ struct PipelineParams {
   GroundParams ground;
   ClusterParams cluster;
   FilterParams filters;
+  NearFieldParams near_field;
 };
 
 // The published pipeline's parameters (config/published.yaml): for tests and benchmarks.

@@ -1,6 +1,8 @@
 #pragma once
 // One LiDAR rotation in, obstacles out: ROI and body removal, voxel grid, ground segmentation, Euclidean
-// clustering, cluster filters, obstacle boxes. Value types only: no sockets, no config parsing, no logging.
+// clustering, cluster filters, obstacle boxes; the 2D LiDAR's points of a merged frame (LidarPoint::source)
+// go to the near-field stage instead (near_field.hpp), whose obstacles are merged with the 3D ones. Value
+// types only: no sockets, no config parsing, no logging.
 // Thread-compatible: a Pipeline holds scratch buffers, so each worker thread owns one; the output depends
 // only on the input points and the parameters (deterministic, whatever thread runs it).
 
@@ -25,7 +27,8 @@ class Pipeline {
 
   [[nodiscard]] FrameResult process(std::span<const LidarPoint> points);
 
-  // The points of the last processed frame after ROI and voxel grid, labelled; valid until the next process().
+  // The 3D points of the last processed frame after ROI and voxel grid, labelled (no 2D point); valid until
+  // the next process().
   [[nodiscard]] std::span<const LabeledPoint> last_points() const;
 
   // The local ground height (m, sensor frame) under (x, y) as the last processed frame found it: the RANSAC
