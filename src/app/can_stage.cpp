@@ -24,6 +24,11 @@ void CanStage::sensor_data(safety::Sensor s, Stamp t) {
   input_.sensors[static_cast<std::size_t>(s)].last_data = t;
 }
 
+void CanStage::sensor_problem(safety::Sensor s, safety::Problem p) {
+  auto& slot = input_.sensors[static_cast<std::size_t>(s)].problem;
+  if (slot == safety::Problem::None) slot = p;
+}
+
 void CanStage::tick(Stamp now, std::uint64_t frames_lost) { schedule_.tick(now, heartbeat(frames_lost)); }
 
 output::StopRequest CanStage::request_for(const safety::Decision& d) {

@@ -37,6 +37,9 @@ class CanStage {
   void frame(const LidarFrame& f, const perception::FrameResult& result, Stamp complete, std::uint64_t frames_lost);
   // A sensor other than the 3D LiDAR was heard at `t` (live: the io threads' receive times).
   void sensor_data(output::safety::Sensor s, Stamp t);
+  // A GNSS or AHRS sample failed its plausibility check (SensorFusion::take_problems()); the next decision
+  // sees the first such problem.
+  void sensor_problem(output::safety::Sensor s, output::safety::Problem p);
   // Heartbeats (with the latest stop request) due up to `now`.
   void tick(Stamp now, std::uint64_t frames_lost);
 

@@ -282,9 +282,19 @@ void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& 
   }
 }
 
+void read_near_field(YamlReader& r, const YAML::Node& n, perception::NearFieldParams& p) {
+  const std::string path = "perception.near_field";
+  if (!r.section(n, path, {"enabled", "zone", "max_gap_m", "min_points", "min_height_m"})) return;
+  if (auto e = r.choice(n, path, "enabled", {"false", "true"})) p.enabled = *e == 1;
+  read_box(r, n["zone"], path + ".zone", p.zone);
+  r.number(n, path, "max_gap_m", p.max_gap_m, 0.01, 5.0, "m");
+  r.integer(n, path, "min_points", p.min_points, 1, 1081);  // a scan has 1081 steps
+  r.number(n, path, "min_height_m", p.min_height_m, 0.0, 2.0, "m");
+}
+
 void read_perception(YamlReader& r, const YAML::Node& n, perception::PipelineParams& p) {
   const std::string path = "perception";
-  if (!r.section(n, path, {"voxel", "roi", "body", "ground", "cluster", "filters"})) return;
+  if (!r.section(n, path, {"voxel", "roi", "body", "ground", "cluster", "filters", "near_field"})) return;
 
   read_voxel(r, n["voxel"], p.voxel);
   read_box(r, n["roi"], "perception.roi", p.roi);
@@ -297,6 +307,7 @@ void read_perception(YamlReader& r, const YAML::Node& n, perception::PipelinePar
   read_ground(r, n["ground"], p.ground);
   read_cluster(r, n["cluster"], p.cluster);
   read_filters(r, n["filters"], p.filters);
+  read_near_field(r, n["near_field"], p.near_field);
 }
 
 LoadResult load(const std::string& text, const std::string& name, const std::string& config_dir) {
@@ -315,11 +326,13 @@ LoadResult load(const std::string& text, const std::string& name, const std::str
     result.issues.push_back({name, 0, "", "the file is empty; start from config/fieldguard.yaml"});
     return result;
   }
-  if (r.section(root, "", {"lidar", "scan2d", "gnss", "ahrs", "perception", "safety", "pipeline", "can"})) {
+  if (r.section(root, "", {"lidar", "scan2d", "gnss", "ahrs", "sync", "geo", "perception", "safety", "pipeline", "can"})) {
     read_lidar(r, root["lidar"], config_dir, result.config.lidar);
     read_scan2d(r, root["scan2d"], result.config.scan2d);
     read_gnss(r, root["gnss"], result.config.gnss);
     read_ahrs(r, root["ahrs"], result.config.ahrs);
+    read_sync(r, root["sync"], result.config.sync);
+    read_geo(r, root["geo"], result.config.geo);
     read_perception(r, root["perception"], result.config.perception);
     read_safety(r, root["safety"], result.config);
     read_pipeline(r, root["pipeline"], result.config.pipeline);

@@ -23,14 +23,86 @@ void vec(std::string& s, const float* v, int n) {
   s += ']';
 }
 
+const char* levelling_name(geo::Levelling l) {
+  switch (l) {
+    case geo::Levelling::Full: return "full";
+    case geo::Levelling::AttitudeOnly: return "attitude_only";
+    case geo::Levelling::None: return "none";
+  }
+  return "?";
+}
+
+void fusion_json(std::string& s, const FusionInfo& f) {
+  s += ",\"fusion\":{\"levelling\":\"";
+  s += levelling_name(f.levelling);
+  s += "\",\"rotations\":" + std::to_string(f.rotations) + ",\"scan_points\":" + std::to_string(f.scan_points) +
+       ",\"missing\":[";
+  bool first = true;
+  for (const sync::SensorKind k : sync::kAllSensors) {
+    if ((f.missing & sync::bit(k)) == 0) continue;
+    s += first ? "\"" : ",\"";
+    s += sync::to_string(k);
+    s += '"';
+    first = false;
+  }
+  s += "],\"timed_out\":";
+  s += f.timed_out ? "true" : "false";
+  s += ",\"dropped_points\":" + std::to_string(f.stats.lidar.dropped() + f.stats.scan.dropped());
+  if (f.attitude) {
+    s += ",\"pose\":{";
+    if (f.reference) {
+      s += "\"easting\":";
+      num(s, f.reference->easting_m, 3);
+      s += ",\"northing\":";
+      num(s, f.reference->northing_m, 3);
+      s += ",\"up\":";
+      num(s, f.reference->up_m, 3);
+      s += ",\"zone\":" + std::to_string(f.reference->zone) + ",";
+    }
+    s += "\"roll\":";
+    num(s, f.attitude->roll_deg, 3);
+    s += ",\"pitch\":";
+    num(s, f.attitude->pitch_deg, 3);
+    s += ",\"yaw\":";
+    num(s, f.attitude->yaw_deg, 3);
+    s += '}';
+  }
+  s += '}';
+}
+
+// The level frame is the plane frame turned by the heading and moved to the reference point
+// (geo/deskew.hpp): p_plane = P_ref + Rz(yaw) p_level, and p_level = p_detect + the LiDAR's mounting.
+void plane_json(std::string& s, const perception::Obstacle& o, const FusionInfo& f, const Mounting& lidar) {
+  const double x = 0.5 * (static_cast<double>(o.min[0]) + static_cast<double>(o.max[0])) + lidar.x_m;
+  const double y = 0.5 * (static_cast<double>(o.min[1]) + static_cast<double>(o.max[1])) + lidar.y_m;
+  const double z = static_cast<double>(o.min[2]) + lidar.z_m;
+  const double yaw = f.attitude->yaw_deg * (3.14159265358979323846 / 180.0);
+  const double c = std::cos(yaw);
+  const double sn = std::sin(yaw);
+  const double e = f.reference->easting_m + c * x - sn * y;
+  const double n = f.reference->northing_m + sn * x + c * y;
+  const double u = f.reference->up_m + z;
+  s += ",\"plane\":[";
+  num(s, e, 3);
+  s += ',';
+  num(s, n, 3);
+  s += ',';
+  num(s, u, 3);
+  s += ']';
+}
+
 }  // namespace
 
-std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result) {
+std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result, const FusionInfo* fusion,
+                                const Mounting* lidar) {
   std::string s = "{\"frame\":" + std::to_string(frame.index) + ",\"stamp\":";
   num(s, frame.host_stamp.seconds(), 6);
   s += ",\"partial\":";
   s += frame.partial ? "true" : "false";
-  s += ",\"points_in\":" + std::to_string(frame.points.size()) + ",\"obstacles\":[";
+  s += ",\"points_in\":" + std::to_string(frame.points.size());
+  if (fusion != nullptr) fusion_json(s, *fusion);
+  const bool plane = fusion != nullptr && lidar != nullptr && fusion->reference && fusion->attitude;
+  s += ",\"obstacles\":[";
   bool first = true;
   for (const auto& o : result.obstacles) {
     if (!first) s += ',';
@@ -55,7 +127,11 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
     num(s, static_cast<double>(o.height_above_ground_m), 3);
     s += ",\"class\":\"";
     s += perception::to_string(o.size_class);
-    s += "\"}";
+    s += '"';
+    // Only frames that carry a 2D scan can have it: a 3D LiDAR's output keeps its old bytes.
+    if ((o.sources & perception::kSeenBy2d) != 0) s += (o.sources & perception::kSeenBy3d) != 0 ? ",\"seen_by\":\"3d+2d\"" : ",\"seen_by\":\"2d\"";
+    if (plane) plane_json(s, o, *fusion, *lidar);
+    s += '}';
   }
   s += "]}";
   return s;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -18,10 +19,12 @@
 #include "app/bev.hpp"
 #include "app/can_stage.hpp"
 #include "app/commands.hpp"
+#include "app/fusion.hpp"
 #include "app/logging.hpp"
 #include "app/obstacles_jsonl.hpp"
 #include "app/pcd_writer.hpp"
 #include "app/png_writer.hpp"
+#include "app/recording.hpp"
 #include "app/samples.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/perception/pipeline.hpp"
@@ -31,6 +34,7 @@
 #include "fieldguard/io/pcap_reader.hpp"
 #include "fieldguard/output/can_sink.hpp"
 #include "fieldguard/sync/ordered_pool.hpp"
+#include "fieldguard/sync/synchronizer.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -42,9 +46,14 @@ constexpr const char* kHelp =
     "                         [--pcd-dir DIR] [--samples-out FILE] [--can-log FILE] [--workers N] [--quiet]\n"
     "\n"
     "Runs a capture of Velodyne packets (classic pcap or pcapng; Ethernet, VLAN, Linux cooked SLL/SLL2 or raw\n"
-    "IPv4) through the decoder and cuts it into rotations.\n"
+    "IPv4) through the decoder and the same frame path as the daemon. The capture alone gives one frame per\n"
+    "rotation, in the 3D LiDAR's sensor frame. With the byte logs of the 2D LiDAR, GNSS or AHRS (a --session, or\n"
+    "the --*-log options) the capture and the logs are merged by receive time and fused as live: frames of whole\n"
+    "rotations at sync.rate_hz with the 2D scan nearest in time, each point deskewed with the vehicle's pose\n"
+    "(`geo:`) into the levelled detection frame (x the heading, y left, z up, origin at the 3D LiDAR's mounting),\n"
+    "the 2D scan lifted into it; a frame that lacks a sensor goes out after sync.timeout_s, marked.\n"
     "\n"
-    "  --config FILE   configuration (see config/fieldguard.yaml)\n"
+"  --config FILE   configuration (see config/fieldguard.yaml)\n"
     "  --pcap FILE     the capture\n"
     "  --session DIR   a directory written by `fieldguard record`: DIR/lidar.pcap and the byte logs of the 2D\n"
     "                  LiDAR (scan2d.log), GNSS (gnss.log) and AHRS (ahrs.log), each decoded by the same decoders\n"
@@ -52,24 +61,30 @@ constexpr const char* kHelp =
     "  --scan2d-log FILE, --gnss-log FILE, --ahrs-log FILE\n"
     "                  byte logs of a recording given one by one (with --pcap), instead of a --session\n"
     "  --samples-out FILE  write every decoded sample of every sensor as a JSON line (as `record --samples-out`)\n"
-    "  --obstacles-out FILE  run the detection pipeline and write one JSON line per rotation, in order:\n"
+    "  --obstacles-out FILE  run the detection pipeline and write one JSON line per frame, in order:\n"
     "                  {\"frame\", \"stamp\" (s, capture time of the rotation's first packet), \"partial\",\n"
     "                  \"points_in\", \"obstacles\": [{\"min\", \"max\" (m, sensor frame), \"points\", \"obb\",\n"
-    "                  \"distance\" (m), \"bearing\" (deg, + left), \"height\" (m above local ground), \"class\"}]}\n"
-    "  --bev-dir DIR   write a bird's-eye PNG per rotation (points by height, ground dimmed, obstacle boxes\n"
+    "                  \"distance\" (m), \"bearing\" (deg, + left), \"height\" (m above local ground), \"class\"}]};\n"
+    "                  a fused frame adds \"fusion\" (levelling full | attitude_only | none, rotations, scan_points,\n"
+    "                  missing sensors, timed_out, dropped_points, pose: plane easting/northing/up/zone and\n"
+    "                  roll/pitch/yaw deg) and per obstacle \"plane\" [easting, northing, up] of its footprint\n"
+    "  --bev-dir DIR   write a bird's-eye PNG per frame (points by height, ground dimmed, obstacle boxes\n"
     "                  with their distance, ROI and body box, 1 m grid)\n"
-    "  --pcd-dir DIR   write one binary PCD per rotation: frame_NNNNNN.pcd, and frame_NNNNNN_partial.pcd for\n"
+    "  --pcd-dir DIR   write one binary PCD per frame: frame_NNNNNN.pcd, and frame_NNNNNN_partial.pcd for\n"
     "                  the first and last rotations when they are not a full turn (fields x y z intensity ring\n"
-    "                  time; sensor frame x forward, y left, z up, metres; time in s after the rotation start)\n"
+    "                  time; sensor frame x forward, y left, z up, metres; time in s after the rotation start;\n"
+    "                  a fused frame's points are in the detection frame and its ring field holds the 2D scan's\n"
+    "                  step for the 2D LiDAR's points)\n"
     "  --can-log FILE  run the detection pipeline and the safety monitor (`safety:`) and write every CAN frame\n"
     "                  the daemon would have sent (`can:` addresses, DBC config/fieldguard.dbc) as a candump -L\n"
     "                  log stamped with capture time: heartbeats and the stop request every\n"
-    "                  can.heartbeat_period_s from the first packet (STOP, starting up, until the first rotation\n"
-    "                  is decided), and per rotation, when its last packet is in, the obstacle summary, the\n"
-    "                  obstacles and the stop request. Sensors other than the 3D LiDAR count as never heard\n"
+    "                  can.heartbeat_period_s from the first packet (STOP, starting up, until the first frame\n"
+    "                  is decided), and per frame, when its last data is in, the obstacle summary, the\n"
+    "                  obstacles and the stop request. A sensor counts as heard at the receive time of its\n"
+    "                  newest data at or before the decision; one without a log counts as never heard\n"
     "  --workers N     run the detection pipeline on N worker threads (1..64; default: pipeline.workers of the\n"
-    "                  configuration, 1 without it). Every output is written in rotation order on the main\n"
-    "                  thread and is byte-identical for any N; no rotation is ever dropped (the reader waits\n"
+    "                  configuration, 1 without it). Every output is written in frame order on the main\n"
+    "                  thread and is byte-identical for any N; no frame is ever dropped (the reader waits\n"
     "                  for the workers when they fall behind)\n"
     "  --quiet         no progress line\n"
     "\n"
@@ -151,91 +166,29 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
   std::printf("  wall time         %.3f s\n", wall_s);
 }
 
-// The byte logs to replay: a session's, unless given one by one. Each entry: (path, sensor).
-enum class LogKind { Scan2d, Gnss, Ahrs };
-struct LogFile {
-  std::string path;
-  LogKind kind;
-};
-
-// Feeds the byte logs to the sample decoder and prints what each held. False when one cannot be read.
-bool replay_logs(const std::vector<LogFile>& logs, SampleDecoder& samples) {
-  for (const LogFile& l : logs) {
-    auto reader = io::ByteLogReader::open(l.path);
-    if (!reader) {
-      std::fprintf(stderr, "fieldguard replay: %s\n", reader.error().c_str());
-      return false;
-    }
-    std::uint64_t records = 0;
-    while (auto r = reader->next()) {
-      ++records;
-      switch (l.kind) {
-        case LogKind::Scan2d: samples.scan2d(r->bytes, r->direction == io::Direction::ToSensor); break;
-        case LogKind::Gnss: samples.gnss(r->bytes); break;
-        case LogKind::Ahrs: samples.ahrs(r->bytes); break;
-      }
-    }
-    std::printf("  %-17s %llu records (%s)%s%s\n", fs::path(l.path).filename().c_str(),
-                static_cast<unsigned long long>(records), reader->source().c_str(),
-                reader->truncated() ? ", cut short at the end" : "",
-                reader->error().empty() ? "" : (", " + reader->error()).c_str());
+// Receive times of one sensor's data, for the safety monitor of `--can-log`: a frame decided at capture time t
+// must see the sensor as it was at t, not as far as the reader has got, or the output would depend on how far
+// the workers lag behind the reader.
+class HeardTimes {
+ public:
+  void add(Stamp t) { times_.push_back(t); }
+  // The newest time at or before `t` (0 when none); forgets what no later question can need.
+  Stamp at(Stamp t) {
+    while (times_.size() > 1 && times_[1].ns <= t.ns) times_.pop_front();
+    return !times_.empty() && times_.front().ns <= t.ns ? times_.front() : Stamp{};
   }
-  const auto& c = samples.counts();
-  std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages\n",
-              static_cast<unsigned long long>(c.scans), static_cast<unsigned long long>(c.gnss),
-              static_cast<unsigned long long>(c.ahrs));
-  return true;
-}
 
-// A rotation on its way through the worker pool, with the capture time at which replay held all of it (the
-// packet that closed it, or the end of the capture): when the daemon would have decided on it.
-struct Job {
-  LidarFrame frame;
-  Stamp complete;
+ private:
+  std::deque<Stamp> times_;
 };
 
+// A frame on its way through the worker pool: see fusion.hpp.
 struct Processed {
-  perception::FrameResult result;
+  DetectedFrame det;
   std::optional<Image> bev;  // rendered by the worker: it needs that worker's Pipeline::last_points()
 };
 
-using Pool = sync::OrderedPool<Job, Processed>;
-
-// A Pipeline keeps scratch buffers between frames and is not thread-safe, so each worker borrows one for the
-// length of a rotation. There are as many as workers: a worker never finds the set empty.
-class PipelineSet {
- public:
-  PipelineSet(const perception::PipelineParams& params, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) free_.push_back(std::make_unique<perception::Pipeline>(params));
-  }
-  class Lease {
-   public:
-    explicit Lease(PipelineSet& set) : set_(set) {
-      const std::lock_guard lock(set_.mutex_);
-      if (set_.free_.empty()) throw std::logic_error("more workers than pipelines");
-      p_ = std::move(set_.free_.back());
-      set_.free_.pop_back();
-    }
-    ~Lease() {
-      const std::lock_guard lock(set_.mutex_);
-      set_.free_.push_back(std::move(p_));
-    }
-    Lease(const Lease&) = delete;
-    Lease& operator=(const Lease&) = delete;
-    Lease(Lease&&) = delete;
-    Lease& operator=(Lease&&) = delete;
-    perception::Pipeline& operator*() const { return *p_; }
-    perception::Pipeline* operator->() const { return p_.get(); }
-
-   private:
-    PipelineSet& set_;
-    std::unique_ptr<perception::Pipeline> p_;
-  };
-
- private:
-  std::mutex mutex_;
-  std::vector<std::unique_ptr<perception::Pipeline>> free_;
-};
+using Pool = sync::OrderedPool<FrameJob, Processed>;
 
 // --workers: 1..64 (sync::PoolParams' limits). Empty optional and a message when it is not.
 std::optional<std::size_t> parse_workers(const std::string& text, std::string& error) {
@@ -312,12 +265,13 @@ int cmd_replay(const std::vector<std::string>& argv) {
     }
   }
   std::optional<SampleDecoder> samples;
-  if (samples_file.is_open() || !logs.empty()) samples.emplace(cfg, samples_file.is_open() ? &samples_file : nullptr);
-  auto reader = io::PcapReader::open(pcap_path);
-  if (!reader) {
-    std::fprintf(stderr, "fieldguard replay: %s\n", reader.error().c_str());
+  if (samples_file.is_open()) samples.emplace(cfg, &samples_file);
+  auto recording = RecordingReader::open(pcap_path, logs);
+  if (!recording) {
+    std::fprintf(stderr, "fieldguard replay: %s\n", recording.error().c_str());
     return kExitBadInput;
   }
+  const FusionInputs inputs{recording->has(LogKind::Scan2d), recording->has(LogKind::Gnss), recording->has(LogKind::Ahrs)};
 
   auto make_dir = [](const std::string& option, const std::string& dir) {
     std::error_code ec;
@@ -355,16 +309,26 @@ int cmd_replay(const std::vector<std::string>& argv) {
   auto can_log_error = [&] {
     return "cannot write " + *args.get("can-log") + ": " + std::strerror(can_log->stats().last_errno);
   };
+  SensorFusion fusion(cfg, inputs);
   const bool detect = obstacles_out.is_open() || !bev_dir.empty() || can.has_value();
-  std::optional<PipelineSet> pipelines;
-  if (detect) pipelines.emplace(cfg.perception, workers);
+  // A fused frame needs the compensation even when only its points are written.
+  std::optional<DetectorSet> detectors;
+  if (detect || fusion.fused()) detectors.emplace(cfg, workers);
   std::uint64_t obstacles_total = 0;
-
-  velodyne::Stream stream(velodyne_stream_options(cfg.lidar));
+  std::array<HeardTimes, 3> heard;  // scan2d, gnss, ahrs: LogKind order
+  // Implausible GNSS / AHRS samples, by receive time: each goes to the first decision at or after it.
+  struct TimedProblem {
+    Stamp at;
+    output::safety::Sensor sensor;
+    output::safety::Problem problem;
+  };
+  std::deque<TimedProblem> problems;
+  const output::safety::Sensor kHeardSensor[] = {output::safety::Sensor::Scan2d, output::safety::Sensor::Gnss,
+                                                 output::safety::Sensor::Ahrs};
 
   PositionCounters pos;
   PortCounters ports;
-  std::vector<LidarFrame> frames;
+  std::vector<FrameJob> jobs;
   std::uint64_t written = 0;
   std::uint64_t lost = 0;
   std::string write_error;
@@ -373,28 +337,33 @@ int cmd_replay(const std::vector<std::string>& argv) {
   const bool progress = !args.has("quiet") && isatty(STDERR_FILENO) != 0;
   auto last_progress = started;
 
-  // Workers: perception (and the bird's-eye picture, which needs the worker's pipeline). Everything that is
-  // written happens in deliver(), on this thread, in rotation order: the output does not depend on the count.
-  auto process = [&](Job& job) {
+  // Workers: compensation, perception (and the bird's-eye picture, which needs the worker's pipeline). Everything
+  // that is written happens in deliver(), on this thread, in frame order: the output does not depend on the count.
+  auto process = [&](FrameJob& job) {
     Processed out;
-    if (!pipelines) return out;
-    const PipelineSet::Lease pipeline(*pipelines);
-    out.result = pipeline->process(job.frame.points);
-    if (!bev_dir.empty()) out.bev = render_bev(pipeline->last_points(), out.result, cfg.perception, std::nullopt);
+    if (!detectors) {
+      out.det.frame = std::move(job.rotation);
+      return out;
+    }
+    const DetectorSet::Lease detector(*detectors);
+    out.det = detector->process(job, detect);
+    if (!bev_dir.empty()) out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg.perception, std::nullopt);
     return out;
   };
   auto deliver = [&](const Pool::Result& r) {
-    const LidarFrame& f = r.input->frame;
     if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
       // Replay uses the non-dropping submit, so this is a failed pipeline run; it is reported, never skipped.
       ++lost;
       if (write_error.empty()) {
-        write_error = "rotation " + std::to_string(f.index) + " was not processed (" + sync::to_string(r.outcome) +
-                      (r.error != nullptr ? ": " + *r.error : std::string()) + ")";
+        const FrameJob& j = *r.input;
+        write_error = "frame " + std::to_string(j.synced ? j.synced->seq : j.rotation.index) + " was not processed (" +
+                      sync::to_string(r.outcome) + (r.error != nullptr ? ": " + *r.error : std::string()) + ")";
       }
       return;
     }
     if (!write_error.empty()) return;
+    const LidarFrame& f = r.output->det.frame;
+    const FusionInfo* fused = r.output->det.fusion ? &*r.output->det.fusion : nullptr;
     char stem[64];
     std::snprintf(stem, sizeof stem, "frame_%06llu%s", static_cast<unsigned long long>(f.index),
                   f.partial ? "_partial" : "");
@@ -402,17 +371,25 @@ int cmd_replay(const std::vector<std::string>& argv) {
       write_error = write_pcd((fs::path(pcd_dir) / (std::string(stem) + ".pcd")).string(), f);
       if (write_error.empty()) ++written;
     }
-    if (!pipelines) return;
-    const perception::FrameResult& result = r.output->result;
+    if (!detect) return;
+    const perception::FrameResult& result = r.output->det.result;
     obstacles_total += result.obstacles.size();
     if (obstacles_out.is_open() && write_error.empty()) {
-      obstacles_out << obstacles_json_line(f, result) << '\n';
+      obstacles_out << obstacles_json_line(f, result, fused, &cfg.lidar.mounting) << '\n';
       if (!obstacles_out) write_error = "cannot write " + *args.get("obstacles-out");
     }
     if (r.output->bev && write_error.empty()) {
       write_error = write_png((fs::path(bev_dir) / (std::string(stem) + ".png")).string(), *r.output->bev);
     }
     if (can) {
+      for (std::size_t i = 0; i < heard.size(); ++i) {
+        const Stamp t = heard[i].at(r.input->complete);
+        if (t.ns != 0) can->sensor_data(kHeardSensor[i], t);
+      }
+      while (!problems.empty() && problems.front().at.ns <= r.input->complete.ns) {
+        can->sensor_problem(problems.front().sensor, problems.front().problem);
+        problems.pop_front();
+      }
       can->frame(f, result, r.input->complete, lost);
       if (can_log->stats().write_errors != 0 && write_error.empty()) write_error = can_log_error();
     }
@@ -421,39 +398,30 @@ int cmd_replay(const std::vector<std::string>& argv) {
   pool_params.workers = workers;
   pool_params.queue_capacity = static_cast<std::size_t>(cfg.pipeline.queue_capacity);
   Pool pool(pool_params, process);
-  Job job;
-  auto handle_frames = [&](Stamp complete) {
-    for (auto& f : frames) {
-      using std::swap;
-      swap(job.frame, f);
-      job.complete = complete;
-      // Back-pressure instead of a drop: replay must lose no rotation, so a full queue waits for results.
-      while (!pool.try_submit(job)) pool.poll_wait(deliver);
+  auto handle_jobs = [&] {
+    for (auto& j : jobs) {
+      // Back-pressure instead of a drop: replay must lose no frame, so a full queue waits for results.
+      while (!pool.try_submit(j)) pool.poll_wait(deliver);
       pool.poll(deliver);
     }
-    frames.clear();
+    jobs.clear();
   };
 
-  while (auto dg = reader->next()) {
-    if (samples) samples->lidar(*dg);
-    if (first_time.ns == 0) {
-      first_time = dg->host_time;
-      if (can) can->start(first_time);
-    }
-    last_time = dg->host_time;
-    if (dg->dst_port == cfg.lidar.data_port) {
-      if (dg->payload.size() != velodyne::kDataPacketSize) {
+  auto on_datagram = [&](const io::UdpDatagram& dg) {
+    if (samples) samples->lidar(dg);
+    if (dg.dst_port == cfg.lidar.data_port) {
+      if (dg.payload.size() != velodyne::kDataPacketSize) {
         ++ports.data_bad_length;
-        continue;
+        return;
       }
-      stream.push(dg->payload, dg->host_time, frames);
-      handle_frames(dg->host_time);
-    } else if (dg->dst_port == cfg.lidar.position_port) {
+      fusion.lidar(dg.payload, dg.host_time, jobs);
+      handle_jobs();
+    } else if (dg.dst_port == cfg.lidar.position_port) {
       ++pos.packets;
-      auto p = velodyne::decode_position_packet(dg->payload);
+      auto p = velodyne::decode_position_packet(dg.payload);
       if (!p) {
         ++pos.bad_length;
-        continue;
+        return;
       }
       ++pos.decoded;
       if (p->rmc) ++pos.rmc;
@@ -462,17 +430,56 @@ int cmd_replay(const std::vector<std::string>& argv) {
     } else {
       ++ports.other_port;
     }
+  };
+  auto on_record = [&](LogKind kind, const io::ByteLogRecord& rec) {
+    const bool to_sensor = rec.direction == io::Direction::ToSensor;
+    switch (kind) {
+      case LogKind::Scan2d:
+        if (samples) samples->scan2d(rec.bytes, to_sensor);
+        fusion.scan2d_bytes(rec.bytes, to_sensor, rec.host_time, jobs);
+        break;
+      case LogKind::Gnss:
+        if (samples) samples->gnss(rec.bytes);
+        fusion.gnss(rec.bytes, rec.host_time, jobs);
+        break;
+      case LogKind::Ahrs:
+        if (samples) samples->ahrs(rec.bytes);
+        fusion.ahrs(rec.bytes, rec.host_time, jobs);
+        break;
+    }
+    if (!to_sensor) heard[static_cast<std::size_t>(kind)].add(rec.host_time);
+    if (can) {
+      const auto p = fusion.take_problems();
+      if (p.gnss != output::safety::Problem::None) problems.push_back({p.gnss_at, output::safety::Sensor::Gnss, p.gnss});
+      if (p.ahrs != output::safety::Problem::None) problems.push_back({p.ahrs_at, output::safety::Sensor::Ahrs, p.ahrs});
+    }
+    handle_jobs();
+  };
+
+  // The capture and the byte logs, merged by receive time.
+  while (auto ev = recording->next()) {
+    if (first_time.ns == 0) {
+      first_time = ev->time;
+      if (can) can->start(first_time);
+    }
+    last_time = Stamp{std::max(last_time.ns, ev->time.ns)};
+    if (ev->datagram != nullptr) {
+      on_datagram(*ev->datagram);
+    } else {
+      on_record(ev->kind, *ev->record);
+    }
     if (progress) {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_progress > std::chrono::seconds(1)) {
         last_progress = now;
-        std::fprintf(stderr, "\r  %llu records, %llu rotations ...", static_cast<unsigned long long>(reader->stats().records),
-                     static_cast<unsigned long long>(stream.counters().full_rotations + stream.counters().partial_rotations));
+        std::fprintf(stderr, "\r  %llu records, %llu frames ...",
+                     static_cast<unsigned long long>(recording->capture().stats().records),
+                     static_cast<unsigned long long>(fusion.counts().frames));
       }
     }
   }
-  stream.finish(frames);
-  handle_frames(last_time);
+  fusion.finish(last_time, jobs);
+  handle_jobs();
   pool.stop(sync::Drain::Yes);
   while (pool.outstanding() > 0 && pool.poll(deliver) > 0) {
   }
@@ -482,22 +489,52 @@ int cmd_replay(const std::vector<std::string>& argv) {
   }
   if (progress) std::fprintf(stderr, "\r%60s\r", "");
 
+  const velodyne::Stream& stream = fusion.stream();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  print_summary(pcap_path, reader->stats(), stream, pos, ports, written, wall_s,
+  const io::PcapStats& pcap_stats = recording->capture().stats();
+  print_summary(pcap_path, pcap_stats, stream, pos, ports, written, wall_s,
                 static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
-  if (pipelines) std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
-  std::printf("  workers           %zu, %llu rotations lost\n", workers, static_cast<unsigned long long>(lost));
+  if (detect) std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+  std::printf("  workers           %zu, %llu frames lost\n", workers, static_cast<unsigned long long>(lost));
   if (can) {
     const auto& cc = can->counts();
     std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", static_cast<unsigned long long>(cc.stop_frames),
                 static_cast<unsigned long long>(cc.go_frames), static_cast<unsigned long long>(cc.changes));
     std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log->stats().sent));
   }
-  if (!logs.empty() && !replay_logs(logs, *samples)) return kExitBadInput;
+  for (const auto& l : recording->logs()) {
+    std::printf("  %-17s %llu records (%s)%s%s\n", fs::path(l.file.path).filename().c_str(),
+                static_cast<unsigned long long>(l.records), l.source.c_str(), l.truncated ? ", cut short at the end" : "",
+                l.error.empty() ? "" : (", " + l.error).c_str());
+  }
+  if (!logs.empty()) {
+    const auto& fc = fusion.counts();
+    std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages\n",
+                static_cast<unsigned long long>(fc.scans), static_cast<unsigned long long>(fc.gnss),
+                static_cast<unsigned long long>(fc.ahrs));
+    if (fc.scan_errors + fc.gnss_errors + fc.ahrs_errors != 0) {
+      std::printf("  sample errors     %llu scan2d, %llu gnss, %llu ahrs\n", static_cast<unsigned long long>(fc.scan_errors),
+                  static_cast<unsigned long long>(fc.gnss_errors), static_cast<unsigned long long>(fc.ahrs_errors));
+    }
+  }
+  if (const sync::Synchronizer* sy = fusion.synchronizer()) {
+    const auto& ac = sy->assembler().counters();
+    std::printf("  fused frames      %llu at %.3g Hz: %llu complete, %llu timed out (", static_cast<unsigned long long>(ac.frames),
+                cfg.sync.rate_hz, static_cast<unsigned long long>(ac.complete), static_cast<unsigned long long>(ac.timed_out));
+    bool first = true;
+    for (const sync::SensorKind k : sync::kAllSensors) {
+      const auto n = ac.missing[static_cast<std::size_t>(k)];
+      if (n == 0) continue;
+      std::printf("%s%llu lacking %s", first ? "" : ", ", static_cast<unsigned long long>(n), std::string(sync::to_string(k)).c_str());
+      first = false;
+    }
+    std::printf("%s), %llu late rotations dropped\n", first ? "none lacking a sensor" : "",
+                static_cast<unsigned long long>(ac.late_rotations));
+  }
   if (samples) samples->finish();
 
-  if (reader->stats().truncated) log->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path);
-  if (!reader->stats().read_error.empty()) log->warn("{}: reading stopped early: {}", pcap_path, reader->stats().read_error);
+  if (pcap_stats.truncated) log->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path);
+  if (!pcap_stats.read_error.empty()) log->warn("{}: reading stopped early: {}", pcap_path, pcap_stats.read_error);
   if (cfg.lidar.model != velodyne::Model::Unknown && stream.detector().decided() &&
       *stream.detector().decided() != cfg.lidar.model) {
     log->warn("lidar.model is {} but the packets look like a {} ({}); check the configuration",

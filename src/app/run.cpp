@@ -1,8 +1,8 @@
-// `fieldguard run`: the daemon. The live sources, the rotation cutter and the output stage share one
-// Boost.Asio io_context on the main thread (the io thread); perception runs on an OrderedPool of
-// pipeline.workers threads. A 5 ms timer on the io thread collects finished rotations in order, lets the
-// safety monitor decide on them and, between rotations, on the clock alone, and sends the CAN frames that
-// are due. Frames are the 3D LiDAR's rotations: the other sensors are watched for silence only.
+// `fieldguard run`: the daemon. The live sources, the frame maker (SensorFusion: rotations, or fused frames
+// when a 2D LiDAR, GNSS or AHRS is enabled) and the output stage share one Boost.Asio io_context on the main
+// thread (the io thread); compensation and perception run on an OrderedPool of pipeline.workers threads. A
+// 5 ms timer on the io thread collects finished frames in order, lets the safety monitor decide on them and,
+// between frames, on the clock alone, and sends the CAN frames that are due.
 
 #include <pthread.h>
 
@@ -21,6 +21,7 @@
 
 #include "app/args.hpp"
 #include "app/commands.hpp"
+#include "app/fusion.hpp"
 #include "app/logging.hpp"
 #include "app/run_stage.hpp"
 #include "app/samples.hpp"
@@ -35,6 +36,7 @@
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/sync/health.hpp"
 #include "fieldguard/sync/ordered_pool.hpp"
+#include "fieldguard/sync/synchronizer.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -104,42 +106,7 @@ std::unique_ptr<output::CanSink> make_sink(const SinkKey& k) {
   return std::make_unique<NullSink>();
 }
 
-struct Job {
-  LidarFrame frame;
-  Stamp complete;  // receive time of the packet that completed the rotation
-};
-using Pool = sync::OrderedPool<Job, perception::FrameResult>;
-
-// A Pipeline keeps scratch buffers between rotations and is not thread-safe: each worker borrows one for a
-// rotation. There are as many as workers, so the set is never empty when a worker asks.
-class Pipelines {
- public:
-  Pipelines(const perception::PipelineParams& params, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) free_.push_back(std::make_unique<perception::Pipeline>(params));
-  }
-  perception::FrameResult process(const LidarFrame& f) {
-    std::unique_ptr<perception::Pipeline> p;
-    {
-      const std::lock_guard lock(mutex_);
-      if (free_.empty()) throw std::logic_error("more workers than pipelines");
-      p = std::move(free_.back());
-      free_.pop_back();
-    }
-    struct Return {
-      Pipelines& set;
-      std::unique_ptr<perception::Pipeline>& p;
-      ~Return() {
-        const std::lock_guard lock(set.mutex_);
-        set.free_.push_back(std::move(p));
-      }
-    } give_back{*this, p};
-    return p->process(f.points);
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<std::unique_ptr<perception::Pipeline>> free_;
-};
+using Pool = sync::OrderedPool<FrameJob, DetectedFrame>;
 
 sync::SensorKind kind_of(safety::Sensor s) {
   switch (s) {
@@ -162,9 +129,9 @@ class Session {
         notify_(notify),
         ready_(ready),
         stage_(cfg_, sink),
-        stream_(velodyne_stream_options(cfg_.lidar)),
-        pipelines_(cfg_.perception, static_cast<std::size_t>(cfg_.pipeline.workers)),
-        pool_(pool_params(cfg_), [this](Job& j) { return process(j); }) {}
+        fusion_(cfg_, FusionInputs::enabled_in(cfg_)),
+        detectors_(cfg_, static_cast<std::size_t>(cfg_.pipeline.workers)),
+        pool_(pool_params(cfg_), [this](FrameJob& j) { return process(j); }) {}
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
   Session(Session&&) = delete;
@@ -178,19 +145,35 @@ class Session {
     o.port = cfg_.lidar.data_port;
     udp_ = std::make_unique<io::UdpReceiver>(io_, o, [this](const io::UdpDatagram& d) { on_datagram(d); });
     udp_->start();
-    log_->info("listening for the 3D LiDAR on udp port {}", udp_->local_port());
+    log_->info("listening for the 3D LiDAR on udp port {}; {}", udp_->local_port(),
+               fusion_.fused() ? "frames fused from every enabled sensor at " + std::to_string(cfg_.sync.rate_hz) + " Hz"
+                               : std::string("one frame per rotation"));
     if (cfg_.scan2d.enabled) {
       const io::ScipSourceOptions so = scip_source_options(cfg_.scan2d);
       scip_ = std::make_unique<io::ScipSource>(
-          io_, so, [this](const scip::Scan&, const scip::Geometry&, Stamp t) { heard(safety::Sensor::Scan2d, t); },
+          io_, so,
+          [this](const scip::Scan& scan, const scip::Geometry&, Stamp t) {
+            heard(safety::Sensor::Scan2d, t);
+            fusion_.scan(scan, t, jobs_);
+            submit_jobs();
+          },
           [this](const std::string& w) { log_->info("scan2d: {}", w); });
       scip_->start();
     }
-    // GNSS and AHRS count as heard when their bytes arrive; their content is not checked here yet.
+    // GNSS and AHRS count as heard when their bytes arrive; the bytes go to the frame maker.
     auto serial = [&](const SerialConfig& c, safety::Sensor s, const char* name) {
       if (!c.enabled) return;
       serial_.push_back(std::make_unique<io::SerialReader>(
-          io_, serial_options(c), [this, s](ByteSpan, Stamp t) { heard(s, t); },
+          io_, serial_options(c),
+          [this, s](ByteSpan bytes, Stamp t) {
+            heard(s, t);
+            if (s == safety::Sensor::Gnss) {
+              fusion_.gnss(bytes, t, jobs_);
+            } else {
+              fusion_.ahrs(bytes, t, jobs_);
+            }
+            submit_jobs();
+          },
           [this, name](io::SerialState, const std::string& why) { log_->info("{}: {}", name, why); }));
       serial_.back()->start();
     };
@@ -214,8 +197,12 @@ class Session {
 
   // The output timer: finished rotations in order, then a decision on the clock and the CAN cycles due.
   void on_tick() {
+    pass_problems();
     pool_.poll([this](const Pool::Result& r) { deliver(r); });
     const Stamp now = wall_clock_now();
+    // Frames still waiting for a late sensor go out at their timeout.
+    fusion_.poll(now, jobs_);
+    submit_jobs();
     stage_.tick(now, lost_);
     // A decision on the clock is progress unless rotations are stuck in the pipeline: then the watchdog
     // starves and systemd restarts a daemon whose workers no longer work.
@@ -251,24 +238,40 @@ class Session {
       const auto age = health_.age_s(kind_of(s), now);
       if (p.required && (!age || *age > p.timeout_s)) waiting = kind_of(s);
     }
-    std::string line = health_.status_line(now, waiting, stage_.counts().frames, stream_.counters().partial_rotations);
+    std::string line = health_.status_line(now, waiting, stage_.counts().frames, fusion_.stream().counters().partial_rotations);
     if (const auto& d = stage_.last_decision()) {
       line += d->stop ? " | STOP " + std::string(safety::to_string(d->reason)) : " | GO";
+    }
+    if (const sync::Synchronizer* sy = fusion_.synchronizer()) {
+      if (auto w = sy->waiting_for(now)) line += " | sync waiting for " + std::string(sync::to_string(*w));
     }
     if (stalled_) line += " | pipeline stalled";
     return line;
   }
 
+  // Also what tools/fieldguard-load reads: keep the labels stable.
   void print_summary() const {
     const auto& c = stage_.counts();
     const auto pc = pool_.counters();
-    std::printf("run summary: %s\n  rotations         %llu decided, %llu lost\n  stop decisions    %llu stop, %llu go, "
-                "%llu changes\n  pool              %llu submitted, %llu dropped, %llu refused, %llu failed\n",
-                cfg_.source_file.c_str(), static_cast<unsigned long long>(c.frames),
-                static_cast<unsigned long long>(lost_), static_cast<unsigned long long>(c.stop_frames),
-                static_cast<unsigned long long>(c.go_frames), static_cast<unsigned long long>(c.changes),
-                static_cast<unsigned long long>(pc.submitted), static_cast<unsigned long long>(pc.dropped),
-                static_cast<unsigned long long>(pc.refused), static_cast<unsigned long long>(pc.failed));
+    const auto& sc = fusion_.stream().counters();
+    const auto u = [](std::uint64_t v) { return static_cast<unsigned long long>(v); };
+    std::printf("run summary: %s\n", cfg_.source_file.c_str());
+    std::printf("  frames            %llu decided, %llu lost\n", u(c.frames), u(lost_));
+    std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", u(c.stop_frames), u(c.go_frames), u(c.changes));
+    std::printf("  pool              %llu submitted, %llu dropped, %llu refused, %llu failed\n", u(pc.submitted),
+                u(pc.dropped), u(pc.refused), u(pc.failed));
+    std::printf("  3d lidar          %llu packets, %llu decoded, %llu bad length, %llu full rotations, %llu partial\n",
+                u(sc.packets), u(sc.decoded), u(bad_length_), u(sc.full_rotations), u(sc.partial_rotations));
+    if (const sync::Synchronizer* sy = fusion_.synchronizer()) {
+      const auto& ac = sy->assembler().counters();
+      const auto& fc = fusion_.counts();
+      std::printf("  fused frames      %llu: %llu complete, %llu timed out, %llu overflowed, %llu late rotations dropped\n",
+                  u(ac.frames), u(ac.complete), u(ac.timed_out), u(ac.overflowed), u(ac.late_rotations));
+      std::printf("  lacking           %llu lidar3d, %llu scan2d, %llu gnss, %llu ahrs\n", u(ac.missing[0]), u(ac.missing[1]),
+                  u(ac.missing[2]), u(ac.missing[3]));
+      std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages; errors %llu, %llu, %llu\n",
+                  u(fc.scans), u(fc.gnss), u(fc.ahrs), u(fc.scan_errors), u(fc.gnss_errors), u(fc.ahrs_errors));
+    }
   }
 
   [[nodiscard]] const Config& config() const { return cfg_; }
@@ -282,14 +285,15 @@ class Session {
     return p;
   }
 
-  perception::FrameResult process(Job& j) {
+  DetectedFrame process(FrameJob& j) {
     // Named so that `top -H`, a debugger and the stall test can tell the workers apart.
     thread_local bool named = false;
     if (!named) {
       named = true;
       pthread_setname_np(pthread_self(), "fg-perception");
     }
-    return pipelines_.process(j.frame);
+    const DetectorSet::Lease detector(detectors_);
+    return detector->process(j);
   }
 
   void heard(safety::Sensor s, Stamp t) {
@@ -303,21 +307,30 @@ class Session {
       if (bad_length_++ == 0) log_->warn("3D LiDAR: a {}-byte datagram is not a data packet (counted)", d.payload.size());
       return;
     }
-    stream_.push(d.payload, d.host_time, frames_);
-    for (auto& f : frames_) {
-      health_.sample(sync::SensorKind::Lidar3d, d.host_time);
-      using std::swap;
-      swap(job_.frame, f);
-      job_.complete = d.host_time;
-      if (pool_.submit(job_)) {
+    const auto rotations = [this] {
+      return fusion_.stream().counters().full_rotations + fusion_.stream().counters().partial_rotations;
+    };
+    const auto before = rotations();
+    fusion_.lidar(d.payload, d.host_time, jobs_);
+    if (rotations() != before) health_.sample(sync::SensorKind::Lidar3d, d.host_time);
+    submit_jobs();
+  }
+  // Implausible GNSS / AHRS samples decoded since the last decision go to the next one.
+  void pass_problems() {
+    const auto p = fusion_.take_problems();
+    if (p.gnss != safety::Problem::None) stage_.sensor_problem(safety::Sensor::Gnss, p.gnss);
+    if (p.ahrs != safety::Problem::None) stage_.sensor_problem(safety::Sensor::Ahrs, p.ahrs);
+  }
+  void submit_jobs() {
+    for (auto& j : jobs_) {
+      if (pool_.submit(j)) {
         submitted_.push_back(wall_clock_now());
       } else {
         ++lost_;
       }
     }
-    frames_.clear();
+    jobs_.clear();
   }
-
   void deliver(const Pool::Result& r) {
     if (!submitted_.empty()) submitted_.pop_front();
     // Stopping: what the workers finish now must not follow the last STOP onto the bus.
@@ -325,11 +338,13 @@ class Session {
     if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
       ++lost_;
       if (r.outcome == sync::Outcome::Failed) {
-        log_->error("rotation {}: detection failed: {}", r.input->frame.index, r.error ? *r.error : "?");
+        log_->error("frame {}: detection failed: {}", r.input->synced ? r.input->synced->seq : r.input->rotation.index,
+                    r.error ? *r.error : "?");
       }
       return;
     }
-    stage_.frame(r.input->frame, *r.output, r.input->complete, wall_clock_now(), lost_);
+    pass_problems();
+    stage_.frame(r.output->frame, r.output->result, r.input->complete, wall_clock_now(), lost_);
     if (ready_) notify_.progress(SteadyClock::now());
   }
 
@@ -339,15 +354,14 @@ class Session {
   bool& ready_;
   std::shared_ptr<spdlog::logger> log_ = logger("run");
   LiveStage stage_;
-  velodyne::Stream stream_;
+  SensorFusion fusion_;
   sync::HealthMonitor health_;
-  Pipelines pipelines_;
+  DetectorSet detectors_;
   Pool pool_;
   std::unique_ptr<io::UdpReceiver> udp_;
   std::unique_ptr<io::ScipSource> scip_;
   std::vector<std::unique_ptr<io::SerialReader>> serial_;
-  std::vector<LidarFrame> frames_;
-  Job job_;
+  std::vector<FrameJob> jobs_;
   std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
   std::uint64_t lost_ = 0;       // rotations dropped, refused or failed
   std::uint64_t bad_length_ = 0;

@@ -29,6 +29,11 @@ void LiveStage::sensor_data(safety::Sensor s, Stamp t) {
   if (t.ns > last.ns) last = t;
 }
 
+void LiveStage::sensor_problem(safety::Sensor s, safety::Problem p) {
+  auto& slot = input_.sensors[static_cast<std::size_t>(s)].problem;
+  if (slot == safety::Problem::None) slot = p;
+}
+
 void LiveStage::note(const safety::Decision& d, const char* what) {
   if (!d.event) return;
   ++counts_.changes;

@@ -35,6 +35,8 @@ class LiveStage {
 
   // A sensor's data arrived at host time `t` (the 3D LiDAR: every datagram).
   void sensor_data(output::safety::Sensor s, Stamp t);
+  // A GNSS or AHRS sample failed its plausibility check; the next decision (frame or tick) sees it.
+  void sensor_problem(output::safety::Sensor s, output::safety::Problem p);
   // A finished rotation, decided at `now`; `data_end`: the receive time of the packet that completed it.
   const output::safety::Decision& frame(const LidarFrame& f, const perception::FrameResult& result, Stamp data_end,
                                         Stamp now, std::uint64_t frames_lost);

@@ -36,15 +36,15 @@ std::string num(double v) {
 }
 std::string opt(const std::optional<double>& v) { return v ? num(*v) : "null"; }
 
-scip::ClientConfig scip_config(const Scan2dConfig& c) {
+}  // namespace
+
+scip::ClientConfig scip_client_config(const Scan2dConfig& c) {
   scip::ClientConfig cc;
   cc.scan.first_step = static_cast<std::uint16_t>(c.start_step);
   cc.scan.last_step = static_cast<std::uint16_t>(c.end_step);
   cc.intensity = c.intensity;
   return cc;
 }
-
-}  // namespace
 
 velodyne::StreamOptions velodyne_stream_options(const LidarConfig& c) {
   velodyne::StreamOptions so;
@@ -58,7 +58,7 @@ velodyne::StreamOptions velodyne_stream_options(const LidarConfig& c) {
 }
 
 struct SampleDecoder::Impl {
-  Impl(const Config& c, std::ostream* o) : config(c), out(o), stream(velodyne_stream_options(c.lidar)), session(scip_config(c.scan2d)) {}
+  Impl(const Config& c, std::ostream* o) : config(c), out(o), stream(velodyne_stream_options(c.lidar)), session(scip_client_config(c.scan2d)) {}
 
   Config config;
   std::ostream* out;

@@ -10,6 +10,7 @@
 
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/core/bytes.hpp"
+#include "fieldguard/drivers/scip_client.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/udp_frame.hpp"
 
@@ -17,6 +18,8 @@ namespace fieldguard::app {
 
 // The Velodyne stream as the configuration describes it (replay and the sample decoder build the same one).
 [[nodiscard]] velodyne::StreamOptions velodyne_stream_options(const LidarConfig& lidar);
+// The SCIP client a recording's conversation was held with (replay re-plays it into a scip::Session).
+[[nodiscard]] scip::ClientConfig scip_client_config(const Scan2dConfig& c);
 
 struct SampleCounts {
   std::uint64_t lidar_frames = 0;

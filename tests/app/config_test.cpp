@@ -52,6 +52,7 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.cluster.structure, perception::ClusterStructure::KdTree);
   EXPECT_DOUBLE_EQ(p.filters.min_height_m, 0.0);
   EXPECT_DOUBLE_EQ(p.filters.min_points_full_range_m, 0.0);
+  EXPECT_FALSE(p.near_field.enabled);  // the published method had no 2D LiDAR
   // And it is what the perception module calls the published method.
   const auto pub = perception::published_params();
   EXPECT_EQ(p.ground.method, pub.ground.method);
@@ -59,6 +60,7 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.cluster.method, pub.cluster.method);
   EXPECT_EQ(p.filters.max_points, pub.filters.max_points);
   EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, pub.filters.min_volume_m3);
+  EXPECT_EQ(p.near_field.enabled, pub.near_field.enabled);
 }
 
 TEST(ConfigFiles, FieldguardUsesTheFieldMethods) {
@@ -121,6 +123,12 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.filters.min_height_m, d.filters.min_height_m);
   EXPECT_EQ(p.filters.min_points_full_range_m, d.filters.min_points_full_range_m);
   EXPECT_EQ(p.filters.min_points_floor, d.filters.min_points_floor);
+  EXPECT_EQ(p.near_field.enabled, d.near_field.enabled);
+  EXPECT_EQ(p.near_field.zone.min, d.near_field.zone.min);
+  EXPECT_EQ(p.near_field.zone.max, d.near_field.zone.max);
+  EXPECT_EQ(p.near_field.max_gap_m, d.near_field.max_gap_m);
+  EXPECT_EQ(p.near_field.min_points, d.near_field.min_points);
+  EXPECT_EQ(p.near_field.min_height_m, d.near_field.min_height_m);
 }
 
 TEST(ConfigLoad, ReadsEveryPerceptionKey) {
@@ -151,6 +159,8 @@ perception:
   cluster: {method: adaptive, structure: kdtree, tolerance_m: 0.5, beam_spacing_deg: 2.0, beam_factor: 1.5, max_tolerance_m: 1.0}
   filters: {min_points: 8, max_points: 0, min_volume_m3: 0.01, max_volume_m3: 0, min_height_m: 0.4,
             min_points_full_range_m: 15, min_points_floor: 2}
+  near_field: {enabled: false, zone: {min: [1, -3, -2.5], max: [10, 3, 0.5]}, max_gap_m: 0.25, min_points: 4,
+               min_height_m: 0.2}
 )",
                                   "t.yaml");
   ASSERT_TRUE(r.ok()) << dump(r);
@@ -194,6 +204,13 @@ perception:
   EXPECT_DOUBLE_EQ(f.min_height_m, 0.4);
   EXPECT_DOUBLE_EQ(f.min_points_full_range_m, 15.0);
   EXPECT_EQ(f.min_points_floor, 2);
+  const auto& nf = p.near_field;
+  EXPECT_FALSE(nf.enabled);
+  EXPECT_EQ(nf.zone.min, (std::array<double, 3>{1, -3, -2.5}));
+  EXPECT_EQ(nf.zone.max, (std::array<double, 3>{10, 3, 0.5}));
+  EXPECT_DOUBLE_EQ(nf.max_gap_m, 0.25);
+  EXPECT_EQ(nf.min_points, 4);
+  EXPECT_DOUBLE_EQ(nf.min_height_m, 0.2);
 }
 
 // 0 switches the upper limits off, so a large minimum with a zero maximum is no contradiction.
@@ -314,7 +331,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"not_yaml", "lidar: [1, 2\n", "", "not valid YAML"},
         BadCase{"empty", "", "", "empty"},
         BadCase{"top_level_list", "- 1\n- 2\n", "", "expected a mapping"},
-        BadCase{"unknown_top", "lidr: {}\n", "lidr", "unknown key; known keys here: lidar, scan2d, gnss, ahrs, perception"},
+        BadCase{"unknown_top", "lidr: {}\n", "lidr", "unknown key; known keys here: lidar, scan2d, gnss, ahrs, sync, geo, perception"},
         BadCase{"duplicate", "lidar:\n  data_port: 1\n  data_port: 2\n", "lidar.data_port", "given twice"},
         BadCase{"section_scalar", "perception: 3\n", "perception", "expected a mapping"},
         BadCase{"vec_short", "perception: {roi: {min: [1, 2]}}\n", "perception.roi.min", "list of 3 numbers"},
@@ -354,7 +371,19 @@ INSTANTIATE_TEST_SUITE_P(
                 "perception.ground.ransac.iterations", "out of range"},
         BadCase{"missing_calibration", "lidar: {calibration_file: /nonexistent/cal.xml}\n", "lidar.calibration_file",
                 "cannot read"},
-        BadCase{"mount_key", "lidar: {mounting: {height: 2}}\n", "lidar.mounting.height", "unknown key"}),
+        BadCase{"mount_key", "lidar: {mounting: {height: 2}}\n", "lidar.mounting.height", "unknown key"},
+        BadCase{"near_gap_zero", "perception: {near_field: {max_gap_m: 0}}\n", "perception.near_field.max_gap_m",
+                "out of range"},
+        BadCase{"near_points_zero", "perception: {near_field: {min_points: 0}}\n",
+                "perception.near_field.min_points", "out of range"},
+        BadCase{"near_height_negative", "perception: {near_field: {min_height_m: -0.1}}\n",
+                "perception.near_field.min_height_m", "out of range"},
+        BadCase{"near_zone_order", "perception: {near_field: {zone: {min: [12, -4, -3], max: [0.4, 4, 1]}}}\n",
+                "perception.near_field.zone", "min x must be less than max x"},
+        BadCase{"near_enabled", "perception: {near_field: {enabled: yes}}\n", "perception.near_field.enabled",
+                "false, true"},
+        BadCase{"near_key", "perception: {near_field: {max_gap: 0.3}}\n", "perception.near_field.max_gap",
+                "unknown key"}),
     [](const ::testing::TestParamInfo<BadCase>& p) { return std::string(p.param.name); });
 
 TEST(ConfigLoad, MissingFileSaysSo) {

@@ -81,7 +81,7 @@ void expect_identical_for_any_workers(const std::string& pcap, std::size_t rotat
                                              "' --can-log '" + c.string() + "'" +
                                              (bev ? " --bev-dir '" + b.string() + "'" : std::string())));
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_NE(r.output.find("workers           " + std::to_string(counts[i]) + ", 0 rotations lost"), std::string::npos)
+    EXPECT_NE(r.output.find("workers           " + std::to_string(counts[i]) + ", 0 frames lost"), std::string::npos)
         << r.output;
     obstacles[i] = slurp(o);
     can[i] = slurp(c);
@@ -126,10 +126,10 @@ TEST(ReplayWorkers, CountFromTheConfigUnlessGiven) {
   std::ofstream(cfg) << text;
   auto r = run_fieldguard(replay(cfg, kHdl, ""));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("workers           3, 0 rotations lost"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("workers           3, 0 frames lost"), std::string::npos) << r.output;
   r = run_fieldguard(replay(cfg, kHdl, "--workers 2"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("workers           2, 0 rotations lost"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("workers           2, 0 frames lost"), std::string::npos) << r.output;
 }
 
 TEST(ReplayCan, UnwritableLogIsBadInput) {

@@ -2,15 +2,18 @@
 // on loopback, byte for byte and in order, on the ports --map names, at the capture's pace.
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <signal.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fieldguard/io/pcap_reader.hpp"
@@ -96,6 +99,73 @@ TEST(UdpPlayer, UnmappedPortsAreSkippedAndLoopsRepeat) {
   const auto once = expected;
   expected.insert(expected.end(), once.begin(), once.end());
   EXPECT_EQ(data.drain().size(), expected.size());
+}
+
+std::int64_t wall_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::uint32_t stamp_of(const std::vector<std::uint8_t>& p) {
+  return static_cast<std::uint32_t>(p[1200]) | static_cast<std::uint32_t>(p[1201]) << 8U |
+         static_cast<std::uint32_t>(p[1202]) << 16U | static_cast<std::uint32_t>(p[1203]) << 24U;
+}
+
+// --live-time: a looped capture's LiDAR clock runs on with the host's UTC clock instead of jumping back to the
+// capture's first stamp at every loop; everything else in every datagram is the capture's.
+TEST(UdpPlayer, LiveTimeStampsDataPacketsWithTheWallClockAcrossLoops) {
+  constexpr std::int64_t kHourUs = 3'600'000'000LL;
+  const auto data_in = payloads(2368);
+  const auto position_in = payloads(8308);
+  ASSERT_EQ(data_in.size(), 540U);
+  // Without the rewrite the stamps would go back at each seam: the capture's last stamp is after its first.
+  ASSERT_GT(stamp_of(data_in.back()), stamp_of(data_in.front()));
+  Port data;
+  Port position;
+  const std::int64_t before = wall_us();
+  testing::ChildProcess player({FIELDGUARD_UDP_PLAYER, "--pcap", kCapture, "--map",
+                                "2368:" + std::to_string(data.port()), "--map",
+                                "8308:" + std::to_string(position.port()), "--loop", "3", "--live-time"});
+  EXPECT_EQ(player.line(), "playing 600 datagrams");
+  EXPECT_EQ(player.wait(), 0);
+  const std::int64_t after = wall_us();
+  const auto got = data.drain();
+  ASSERT_EQ(got.size(), 3 * data_in.size());
+  std::int64_t previous = 0;
+  std::int64_t first = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    const auto& in = data_in[i % data_in.size()];
+    ASSERT_EQ(got[i].size(), in.size());
+    EXPECT_TRUE(std::equal(in.begin(), in.begin() + 1200, got[i].begin())) << i;
+    EXPECT_TRUE(std::equal(in.begin() + 1204, in.end(), got[i].begin() + 1204)) << i;
+    // The stamp is µs past the UTC hour at sending: between `before` and `after`, across an hour's top too.
+    std::int64_t at = before - before % kHourUs + stamp_of(got[i]);
+    if (at < before - 1000) at += kHourUs;
+    EXPECT_GE(at, before - 1000) << i;  // 1 ms for the microsecond truncation of both clocks
+    EXPECT_LE(at, after) << i;
+    if (i > 0) {
+      EXPECT_GE(at, previous) << i;
+    }
+    if (i == 0) first = at;
+    previous = at;
+  }
+  // At the capture's pace: three loops of 0.3 s span at least 0.85 s of sensor time.
+  EXPECT_GE(previous - first, 850'000);
+  // Position packets (512 bytes) are not data packets: untouched.
+  auto position_expected = position_in;
+  for (int l = 0; l < 2; ++l) position_expected.insert(position_expected.end(), position_in.begin(), position_in.end());
+  EXPECT_EQ(position.drain(), position_expected);
+}
+
+TEST(UdpPlayer, SigtermStopsAndStillPrintsTheSummary) {
+  Port data;
+  testing::ChildProcess player({FIELDGUARD_UDP_PLAYER, "--pcap", kCapture, "--map",
+                                "2368:" + std::to_string(data.port()), "--loop", "1000000"});
+  EXPECT_EQ(player.line(), "playing 540 datagrams");
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  player.signal(SIGTERM);
+  EXPECT_EQ(player.wait(), 0);  // exited by itself (-1 if the signal had killed it)
+  EXPECT_GT(data.drain().size(), 0U);
 }
 
 TEST(UdpPlayer, BadCommandLinesExitTwo) {

@@ -51,6 +51,11 @@ class ChildProcess {
     return s;
   }
 
+  // Sends it a signal (SIGTERM: how a daemon or an emulator is told to stop and report).
+  void signal(int sig) const {
+    if (pid_ > 0) ::kill(pid_, sig);
+  }
+
   // Waits for it to exit by itself; its exit code, or -1 when a signal ended it.
   int wait() {
     int status = 0;

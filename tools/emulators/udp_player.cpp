@@ -2,10 +2,14 @@
 // sockets, paced by the capture's own record times: a LiDAR on the bench for the daemon's live path and
 // its end-to-end tests. Each datagram goes to the port it was captured on, or to the port --map gives.
 // Prints "playing N datagrams" on stdout once the capture is read, then plays; prints a summary on stderr.
-// When the capture ends (and its loops), the player exits: the "sensor" falls silent.
+// When the capture ends (and its loops), the player exits: the "sensor" falls silent. SIGTERM or SIGINT
+// stops it early, still with the summary (how many datagrams went out is what a load test compares).
+// --live-time restamps every HDL-32E data packet with the sending host's wall clock, as a GPS-synchronised
+// sensor stamps its packets, so a looped capture's sensor clock runs on instead of jumping back at each loop.
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <signal.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -25,7 +29,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: fieldguard-udp-player --pcap FILE [--host ADDR] [--map FROM:TO]... [--speed X] [--loop N]\n"
-    "                             [--delay SECONDS]\n"
+    "                             [--delay SECONDS] [--live-time]\n"
     "  --pcap FILE       the capture to play (pcap or pcapng; every UDP datagram in it)\n"
     "  --host ADDR       IPv4 address to send to (default 127.0.0.1)\n"
     "  --map FROM:TO     send datagrams captured on port FROM to port TO (default: the captured port);\n"
@@ -33,7 +37,24 @@ constexpr const char* kUsage =
     "  --speed X         1 = the capture's pace (default), 2 = twice as fast, 0 = as fast as possible\n"
     "  --loop N          play the capture N times, each after the previous (default 1)\n"
     "  --delay SECONDS   wait this long after printing the count before the first datagram (default 0)\n"
+    "  --live-time       rewrite the timestamp of every 1206-byte data packet (u32 LE at byte 1200) to the\n"
+    "                    host's UTC wall clock in microseconds past the hour when it is sent\n"
     "Exit codes: 0 played, 1 a send failed, 2 bad command line or unreadable capture.\n";
+
+// The HDL-32E data packet and its timestamp field (protocols.md §1: u32 LE, µs past the top of the UTC hour).
+constexpr std::size_t kDataPacketSize = 1206;
+constexpr std::size_t kTimestampOffset = 1200;
+constexpr std::int64_t kUsPerHour = 3'600'000'000LL;
+
+void stamp_now(std::vector<std::uint8_t>& payload) {
+  const std::int64_t us =
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const auto past_hour = static_cast<std::uint32_t>(((us % kUsPerHour) + kUsPerHour) % kUsPerHour);
+  for (std::size_t i = 0; i < 4; ++i) payload[kTimestampOffset + i] = static_cast<std::uint8_t>(past_hour >> (8U * i));
+}
+
+volatile sig_atomic_t g_stop = 0;
+extern "C" void on_stop_signal(int /*signal*/) { g_stop = 1; }
 
 struct Datagram {
   std::int64_t t_ns;  // record time
@@ -50,6 +71,7 @@ int main(int argc, char** argv) {
   double speed = 1.0;
   long loops = 1;
   double delay_s = 0.0;
+  bool live_time = false;
   fieldguard::tools::Options opt(argc, argv, "fieldguard-udp-player", kUsage);
   while (opt.next()) {
     if (opt.is("--pcap")) {
@@ -71,6 +93,8 @@ int main(int argc, char** argv) {
       loops = opt.integer(1, 1'000'000);
     } else if (opt.is("--delay")) {
       delay_s = opt.number(0.0, 3600.0);
+    } else if (opt.is("--live-time")) {
+      live_time = true;
     } else {
       opt.unknown();
     }
@@ -117,6 +141,11 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   if (delay_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
 
+  struct sigaction sa{};
+  sa.sa_handler = on_stop_signal;
+  sa.sa_flags = SA_RESTART;
+  ::sigaction(SIGTERM, &sa, nullptr);
+  ::sigaction(SIGINT, &sa, nullptr);
   using Clock = std::chrono::steady_clock;
   const std::int64_t span_ns = datagrams.back().t_ns - datagrams.front().t_ns;
   // One capture period between loops, so that a looped capture keeps its packet spacing at the seam.
@@ -124,13 +153,16 @@ int main(int argc, char** argv) {
       span_ns + (datagrams.size() > 1 ? span_ns / static_cast<std::int64_t>(datagrams.size() - 1) : 0);
   const Clock::time_point start = Clock::now();
   std::uint64_t sent = 0;
-  for (long l = 0; l < loops; ++l) {
-    for (const Datagram& d : datagrams) {
+  std::uint64_t sent_data = 0;
+  for (long l = 0; l < loops && g_stop == 0; ++l) {
+    for (Datagram& d : datagrams) {
+      if (g_stop != 0) break;
       if (speed > 0.0) {
         const double offset_s = static_cast<double>(d.t_ns - datagrams.front().t_ns + l * period_ns) * 1e-9 / speed;
         std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
                                                   std::chrono::duration<double>(offset_s)));
       }
+      if (live_time && d.payload.size() == kDataPacketSize) stamp_now(d.payload);
       to.sin_port = htons(d.port);
       if (::sendto(fd, d.payload.data(), d.payload.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to) !=
           static_cast<ssize_t>(d.payload.size())) {
@@ -140,11 +172,13 @@ int main(int argc, char** argv) {
         return 1;
       }
       ++sent;
+      if (d.payload.size() == kDataPacketSize) ++sent_data;
     }
   }
   ::close(fd);
   const double took = std::chrono::duration<double>(Clock::now() - start).count();
-  std::fprintf(stderr, "fieldguard-udp-player: sent %llu datagrams in %.3f s (%llu skipped by --map)\n",
-               static_cast<unsigned long long>(sent), took, static_cast<unsigned long long>(skipped));
+  std::fprintf(stderr, "fieldguard-udp-player: sent %llu datagrams (%llu data packets) in %.3f s (%llu skipped by --map)%s\n",
+               static_cast<unsigned long long>(sent), static_cast<unsigned long long>(sent_data), took,
+               static_cast<unsigned long long>(skipped), g_stop != 0 ? ", stopped by a signal" : "");
   return 0;
 }

@@ -3,17 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <vector>
 
-#include "fieldguard/drivers/nmea.hpp"
 #include "fieldguard/drivers/scip_session.hpp"
-#include "fieldguard/drivers/xsens.hpp"
-#include "fieldguard/drivers/xsens_mtdata2.hpp"
 #include "fieldguard/io/byte_log.hpp"
+#include "nav_encode.hpp"
 #include "scip_sensor.hpp"
 #include "sim/raycaster.hpp"
 #include "sim/rng.hpp"
@@ -35,11 +32,7 @@ constexpr std::uint64_t kScanMsAtZero = 16'700'000;          // wraps (24 bits) 
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
 // v with `decimals` digits after the point.
-std::string fmt(int decimals, double v) {
-  char buf[64];
-  const int n = std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return {buf, static_cast<std::size_t>(std::max(n, 0))};
-}
+std::string fmt(int decimals, double v) { return tools::fixed_text(decimals, v); }
 
 // Exact "s.nnnnnnnnn" of a Unix time in ns.
 std::string stamp_text(std::int64_t ns) {
@@ -50,69 +43,6 @@ std::string stamp_text(std::int64_t ns) {
 }
 
 std::string vec_text(Vec3 v) { return "[" + fmt(4, v.x) + ", " + fmt(4, v.y) + ", " + fmt(4, v.z) + "]"; }
-
-// Civil date of a count of days since 1970-01-01 (H. Hinnant's days_from_civil inverted).
-void civil_from_days(std::int64_t z, int& y, int& m, int& d) {
-  z += 719468;
-  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
-  const auto doe = static_cast<unsigned>(z - era * 146097);
-  const unsigned yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const unsigned doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const unsigned mp = (5 * doy + 2) / 153;
-  d = static_cast<int>(doy - (153 * mp + 2) / 5 + 1);
-  m = static_cast<int>(mp < 10 ? mp + 3 : mp - 9);
-  y = static_cast<int>(static_cast<std::int64_t>(yoe) + era * 400 + (m <= 2 ? 1 : 0));
-}
-
-// "hhmmss.ss" of a UTC time on a whole hundredth.
-std::string nmea_time(std::int64_t ns) {
-  const std::int64_t cs = ns / 10000000;  // hundredths since the epoch
-  const std::int64_t day_cs = cs % 8640000;
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "%02d%02d%02d.%02d", static_cast<int>(day_cs / 360000), static_cast<int>(day_cs / 6000 % 60),
-                static_cast<int>(day_cs / 100 % 60), static_cast<int>(day_cs % 100));
-  return buf;
-}
-
-std::string nmea_date(std::int64_t ns) {
-  int y = 0;
-  int m = 0;
-  int d = 0;
-  civil_from_days(ns / 1000000000 / 86400, y, m, d);
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "%02d%02d%02d", d, m, y % 100);
-  return buf;
-}
-
-// "ddmm.mmmmmmm,N" / "dddmm.mmmmmmm,E": 1e-7 minutes is 0.2 mm, as RTK receivers print it.
-std::string nmea_angle(double deg, int deg_digits, char pos, char neg) {
-  const auto total = static_cast<long long>(std::llround(std::abs(deg) * 60.0 * 1e7));
-  const long long per_deg = 600000000LL;
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%0*lld%02lld.%07lld,%c", deg_digits, total / per_deg, total % per_deg / 10000000LL,
-                total % 10000000LL, deg < 0.0 ? neg : pos);
-  return buf;
-}
-
-std::string nmea_sentence(const std::string& body) {
-  char cs[8];
-  std::snprintf(cs, sizeof cs, "*%02X\r\n", static_cast<unsigned>(nmea::checksum(body)));
-  return "$" + body + cs;
-}
-
-void put_be16(std::vector<std::uint8_t>& out, std::uint16_t v) {
-  out.push_back(static_cast<std::uint8_t>(v >> 8U));
-  out.push_back(static_cast<std::uint8_t>(v & 0xFFU));
-}
-void put_be32(std::vector<std::uint8_t>& out, std::uint32_t v) {
-  for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<std::uint8_t>((v >> static_cast<unsigned>(s)) & 0xFFU));
-}
-void put_float(std::vector<std::uint8_t>& out, double v) {
-  const auto f = static_cast<float>(v);
-  std::uint32_t bits = 0;
-  std::memcpy(&bits, &f, sizeof bits);
-  put_be32(out, bits);
-}
 
 double wrap_deg(double a) {
   a = std::fmod(a, 360.0);
@@ -216,20 +146,18 @@ bool write_gnss(Context& c) {
     const Geodetic meas = c.place.to_geodetic(antenna + Vec3{ex.next(rng), ey.next(rng), ez.next(rng)});
     const double speed = c.scene.travel_at(t).second;
     const double heading_true = std::fmod(c.s.field_heading_deg + 360.0, 360.0);
-    double heading_meas = std::fmod(heading_true + c.s.heading_sigma_deg * rng.normal() + 360.0, 360.0);
-    const std::string time = nmea_time(utc_ns);
-    const std::string lat = nmea_angle(meas.lat_deg, 2, 'N', 'S');
-    const std::string lon = nmea_angle(meas.lon_deg, 3, 'E', 'W');
-    const std::string sats = std::to_string(16 + static_cast<int>(rng.uniform() * 5.0));
-    std::vector<std::string> sentences;
-    sentences.push_back(nmea_sentence("GNGGA," + time + "," + lat + "," + lon + ",4," + sats + ",0.6," +
-                                      fmt(3, meas.h_m - c.s.geoid_separation_m) + ",M," +
-                                      fmt(3, c.s.geoid_separation_m) + ",M,1.0,0001"));
-    const double speed_meas = std::max(0.0, speed + 0.02 * rng.normal());
-    sentences.push_back(nmea_sentence("GNRMC," + time + ",A," + lat + "," + lon + "," + fmt(3, speed_meas * 3600.0 / 1852.0) +
-                                      "," + (speed > 0.1 ? fmt(2, heading_true) : std::string()) + "," +
-                                      nmea_date(utc_ns) + ",,,D"));
-    sentences.push_back(nmea_sentence("GNHDT," + fmt(2, heading_meas) + ",T"));
+    const double heading_meas = std::fmod(heading_true + c.s.heading_sigma_deg * rng.normal() + 360.0, 360.0);
+    tools::GnssEpoch epoch;
+    epoch.utc_ns = utc_ns;
+    epoch.lat_deg = meas.lat_deg;
+    epoch.lon_deg = meas.lon_deg;
+    epoch.h_m = meas.h_m;
+    epoch.geoid_separation_m = c.s.geoid_separation_m;
+    epoch.satellites = 16 + static_cast<int>(rng.uniform() * 5.0);
+    epoch.speed_mps = std::max(0.0, speed + 0.02 * rng.normal());
+    if (speed > 0.1) epoch.course_deg = heading_true;
+    epoch.heading_deg = heading_meas;
+    const std::vector<std::string> sentences = tools::nmea_epoch(epoch);
     // The receiver prints its solution 20-40 ms after the epoch, then the bytes cross the serial line.
     double host_s = t + 0.020 + 0.020 * rng.uniform();
     for (const std::string& line : sentences) {
@@ -258,19 +186,13 @@ bool write_ahrs(Context& c) {
     const auto counter = static_cast<std::uint16_t>(k & 0xFFFFU);
     const auto fine = static_cast<std::uint32_t>(
         (kAhrsFineAtZero + static_cast<std::uint64_t>(std::llround(t * (1.0 + kAhrsDriftPpm * 1e-6) * 10000.0))) & 0xFFFFFFFFULL);
-    std::vector<std::uint8_t> payload;
-    put_be16(payload, xsens::data_id::kPacketCounter);
-    payload.push_back(2);
-    put_be16(payload, counter);
-    put_be16(payload, xsens::data_id::kSampleTimeFine);
-    payload.push_back(4);
-    put_be32(payload, fine);
-    put_be16(payload, xsens::data_id::kEulerAngles);  // Float32, ENU
-    payload.push_back(12);
-    put_float(payload, pose.roll_deg + c.s.ahrs_sigma_deg * rng.normal());
-    put_float(payload, pose.pitch_deg + c.s.ahrs_sigma_deg * rng.normal());
-    put_float(payload, wrap_deg(yaw + 0.1 * rng.normal()));
-    const std::vector<std::uint8_t> frame = xsens::encode_frame(xsens::mid::kMtData2, payload);
+    tools::AhrsSample sample;
+    sample.packet_counter = counter;
+    sample.sample_time_fine = fine;
+    sample.roll_deg = pose.roll_deg + c.s.ahrs_sigma_deg * rng.normal();
+    sample.pitch_deg = pose.pitch_deg + c.s.ahrs_sigma_deg * rng.normal();
+    sample.yaw_deg = wrap_deg(yaw + 0.1 * rng.normal());
+    const std::vector<std::uint8_t> frame = tools::mtdata2_frame(sample);
     const double host_s = t + static_cast<double>(frame.size()) / kSerialBytesPerS + 0.001 + 0.001 * rng.uniform();
     if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, frame.data(), frame.size(), c.error)) return false;
     const VehiclePose v = vehicle_pose(c.scene, pose);

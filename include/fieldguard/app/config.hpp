@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "fieldguard/app/config_fusion.hpp"
 #include "fieldguard/app/config_output.hpp"
 #include "fieldguard/core/mounting.hpp"
 #include "fieldguard/drivers/velodyne_calibration.hpp"
@@ -72,6 +73,8 @@ struct Config {
   Scan2dConfig scan2d;
   GnssConfig gnss;
   AhrsConfig ahrs;
+  SyncConfig sync;                // frames from the sensors' streams
+  GeoConfig geo;                  // pose compensation
   perception::PipelineParams perception;
   output::safety::Params safety;  // the stop decision
   PipelineConfig pipeline;        // the perception worker pool
