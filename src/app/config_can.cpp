@@ -37,7 +37,7 @@ void read_can(YamlReader& r, const YAML::Node& n, const std::string& config_dir,
   const std::string path = "can";
   if (!r.section(n, path,
                  {"sink", "interface", "log_path", "source_address", "controller_address", "max_obstacles",
-                  "heartbeat_period_s"})) {
+                  "heartbeat_period_s", "speed", "speed_timeout_s"})) {
     return;
   }
   if (auto s = r.choice(n, path, "sink", {"socketcan", "candump", "none"})) {
@@ -51,6 +51,10 @@ void read_can(YamlReader& r, const YAML::Node& n, const std::string& config_dir,
   r.integer(n, path, "max_obstacles", max_obstacles, 0, output::kMaxObstacleMessages);
   c.params.max_obstacles = static_cast<std::uint8_t>(max_obstacles);
   r.number(n, path, "heartbeat_period_s", c.heartbeat_period_s, 0.02, 1.0, "s");
+  if (auto s = r.choice(n, path, "speed", {"none", "ccvs1", "iso_wheel_based"})) {
+    c.speed = *s == 0 ? SpeedInput::None : (*s == 1 ? SpeedInput::Ccvs1 : SpeedInput::IsoWheelBased);
+  }
+  r.number(n, path, "speed_timeout_s", c.speed_timeout_s, 0.05, 10.0, "s");
 
   if (const std::string bad = output::check_interface_name(c.interface); !bad.empty()) {
     r.issue(n.IsMap() && n["interface"] ? n["interface"] : n, "can.interface", bad);

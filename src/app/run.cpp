@@ -29,10 +29,12 @@
 #include "app/source_options.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
+#include "fieldguard/io/can_reader.hpp"
 #include "fieldguard/io/scip_source.hpp"
 #include "fieldguard/io/serial_reader.hpp"
 #include "fieldguard/io/udp_receiver.hpp"
 #include "fieldguard/output/can_sink.hpp"
+#include "fieldguard/output/can_speed.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/sync/health.hpp"
 #include "fieldguard/sync/ordered_pool.hpp"
@@ -48,11 +50,13 @@ constexpr const char* kHelp =
     "usage: fieldguard run --config FILE [--can-log FILE] [--quiet]\n"
     "\n"
     "The daemon: receives the enabled live sensors (3D LiDAR over UDP on lidar.data_port; the 2D LiDAR, GNSS\n"
-    "and AHRS when enabled), cuts the 3D LiDAR's stream into rotations, runs obstacle detection on\n"
-    "pipeline.workers threads, decides stop / go with the safety monitor (`safety:`) on every rotation and\n"
-    "between rotations (a silent sensor or a stalled pipeline stops the tractor within its timeout), and\n"
+    "and AHRS when enabled), makes frames of them (each 3D LiDAR rotation alone; fused by `sync:` and compensated\n"
+    "by `geo:` when another sensor is enabled), runs obstacle detection on pipeline.workers threads, decides\n"
+    "stop / go with the safety monitor (`safety:`) on every frame and between frames (a silent or implausible\n"
+    "sensor or a stalled pipeline stops the tractor within its timeout), and\n"
     "sends the CAN messages of config/fieldguard.dbc to the `can:` sink (socketcan | candump | none),\n"
-    "heartbeat and stop request every can.heartbeat_period_s whatever the pipeline does.\n"
+    "heartbeat and stop request every can.heartbeat_period_s whatever the pipeline does. With can.speed set,\n"
+    "the tractor's speed is read off can.interface and sizes the stop zone while it is fresh.\n"
     "\n"
     "  --config FILE   configuration (see config/fieldguard.yaml)\n"
     "  --can-log FILE  write the CAN frames to this candump -L log instead of the configured sink\n"
@@ -179,15 +183,44 @@ class Session {
     };
     serial(cfg_.gnss.serial, safety::Sensor::Gnss, "gnss");
     serial(cfg_.ahrs.serial, safety::Sensor::Ahrs, "ahrs");
+    if (cfg_.can.speed != SpeedInput::None) start_speed_input();
     stage_.tick(now, 0);
   }
 
+  // The tractor's speed off the bus sizes the stop zone. Without it (no SocketCAN, no interface) the zone
+  // keeps its full-speed length: safe, so the daemon runs on and says why once.
+  void start_speed_input() {
+    const bool ccvs1 = cfg_.can.speed == SpeedInput::Ccvs1;
+    const std::uint32_t pgn = ccvs1 ? output::kPgnCcvs1 : output::kPgnIsoWheelBasedSpeed;
+    // The PGN sits in bits 8..25 of the 29-bit identifier; any priority, any sender.
+    const std::vector<io::CanFilter> filters{io::CanFilter{pgn << 8, 0x03FFFF00}};
+    auto fd = io::CanReader::open_socket(cfg_.can.interface, filters);
+    if (!fd) {
+      log_->warn("tractor speed ({}): {}; the stop zone keeps its full-speed length", ccvs1 ? "CCVS1" : "ISO wheel-based",
+                 fd.error());
+      return;
+    }
+    can_in_ = std::make_unique<io::CanReader>(
+        io_, *fd, filters, [this, ccvs1](std::uint32_t id, std::span<const std::uint8_t> data, Stamp t) {
+          auto v = output::decode_speed(id, data);
+          const auto want = ccvs1 ? output::SpeedSource::Ccvs1 : output::SpeedSource::IsoWheelBased;
+          if (v && v->source == want) {
+            stage_.vehicle_speed(v->speed_mps, t);
+          } else if (!v && v.error() != output::SpeedError::OtherPgn && speed_errors_++ == 0) {
+            log_->warn("tractor speed: {} (counted; the zone keeps its full-speed length while no speed is known)",
+                       output::to_string(v.error()));
+          }
+        });
+    can_in_->start();
+    log_->info("reading the tractor's speed ({}) on {}", ccvs1 ? "CCVS1" : "ISO wheel-based", cfg_.can.interface);
+  }
   // Sources closed, queued rotations discarded, the workers joined (each finishes its rotation first).
   void stop() {
     if (stopped_) return;
     stopped_ = true;
     if (udp_) udp_->stop();
     if (scip_) scip_->stop();
+    if (can_in_) can_in_->stop();
     for (auto& s : serial_) s->stop();
     pool_.stop(sync::Drain::No);
     pool_.poll([this](const Pool::Result& r) { deliver(r); });
@@ -360,6 +393,8 @@ class Session {
   Pool pool_;
   std::unique_ptr<io::UdpReceiver> udp_;
   std::unique_ptr<io::ScipSource> scip_;
+  std::unique_ptr<io::CanReader> can_in_;
+  std::uint64_t speed_errors_ = 0;
   std::vector<std::unique_ptr<io::SerialReader>> serial_;
   std::vector<FrameJob> jobs_;
   std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first

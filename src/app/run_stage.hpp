@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/core/lidar_point.hpp"
@@ -35,6 +36,9 @@ class LiveStage {
 
   // A sensor's data arrived at host time `t` (the 3D LiDAR: every datagram).
   void sensor_data(output::safety::Sensor s, Stamp t);
+  // The tractor's speed from the bus, received at `t`; a frame decided within can.speed_timeout_s of it sizes
+  // the stop zone with it (older: unknown, the zone's full-speed length).
+  void vehicle_speed(double speed_mps, Stamp t);
   // A GNSS or AHRS sample failed its plausibility check; the next decision (frame or tick) sees it.
   void sensor_problem(output::safety::Sensor s, output::safety::Problem p);
   // A finished rotation, decided at `now`; `data_end`: the receive time of the packet that completed it.
@@ -60,6 +64,7 @@ class LiveStage {
   output::safety::Input input_;
   std::optional<output::safety::Decision> last_;
   std::optional<output::StopRequest> sent_;  // the stop request the schedule repeats
+  std::optional<std::pair<double, Stamp>> speed_;  // m/s, receive time
   LiveStageCounts counts_;
 };
 

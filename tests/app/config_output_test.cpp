@@ -97,5 +97,20 @@ TEST(ConfigOutput, CandumpNeedsALogAndAddressesMustDiffer) {
   EXPECT_FALSE(n.ok());
 }
 
+TEST(ConfigOutput, SpeedFromTheBus) {
+  const auto d = load_config_text("can: {sink: none}\n", "d.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_EQ(d.config.can.speed, SpeedInput::None);
+  EXPECT_DOUBLE_EQ(d.config.can.speed_timeout_s, 0.5);
+  const auto r = load_config_text("can: {sink: none, speed: iso_wheel_based, speed_timeout_s: 0.3}\n", "s.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  EXPECT_EQ(r.config.can.speed, SpeedInput::IsoWheelBased);
+  EXPECT_DOUBLE_EQ(r.config.can.speed_timeout_s, 0.3);
+  EXPECT_EQ(load_config_text("can: {speed: ccvs1}\n", "c.yaml").config.can.speed, SpeedInput::Ccvs1);
+  const auto bad = load_config_text("can:\n  speed: gps\n  speed_timeout_s: 0\n", "b.yaml");
+  EXPECT_TRUE(has_issue(bad, "can.speed", "", 2)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "can.speed_timeout_s", "", 3)) << dump(bad);
+}
+
 }  // namespace
 }  // namespace fieldguard::app

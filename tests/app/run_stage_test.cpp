@@ -1,5 +1,6 @@
 // The daemon's output stage on a fake clock: decisions between rotations reach the bus at once.
 #include "app/run_stage.hpp"
+#include "fieldguard/output/safety_params.hpp"
 
 #include <gtest/gtest.h>
 
@@ -94,6 +95,55 @@ TEST_F(LiveStageTest, SilenceAfterGoStopsAtTheTimeoutWithoutARotation) {
   EXPECT_EQ(sig(stops().back(), output::stop_sig::Command), 1U);
   EXPECT_EQ(sig(stops().back(), output::stop_sig::ReasonShuttingDown), 1U);
   for (std::size_t i = 1; i < sink.sent.size(); ++i) EXPECT_LE(sink.sent[i - 1].t.ns, sink.sent[i].t.ns);
+}
+
+// The tractor's speed from the bus sizes the zone: an obstacle 10 m ahead is inside the full-speed zone (speed
+// unknown) and outside the zone of a tractor creeping at 1 m/s; a speed older than can.speed_timeout_s is
+// unknown again.
+TEST_F(LiveStageTest, AFreshBusSpeedSizesTheZoneAStaleOneDoesNot) {
+  const double full = cfg.safety.zone.front_x_m + output::safety::zone_length_m(cfg.safety.zone, std::nullopt);
+  const double slow = cfg.safety.zone.front_x_m + output::safety::zone_length_m(cfg.safety.zone, 1.0);
+  ASSERT_GT(full, 10.5);
+  ASSERT_LT(slow, 9.5);
+  LiveStage stage(cfg, sink);
+  perception::FrameResult ahead;
+  perception::Obstacle o;
+  o.min = {9.8F, -0.2F, -0.9F};
+  o.max = {10.2F, 0.2F, 0.8F};
+  o.distance_m = 9.8F;
+  ahead.obstacles.push_back(o);
+  LidarFrame f;
+  std::int64_t t = t0;
+  auto decide = [&](int k) {
+    t = t0 + (k + 1) * 100 * kMs;
+    stage.sensor_data(output::safety::Sensor::Lidar, Stamp{t});
+    f.index = static_cast<std::uint64_t>(k);
+    return stage.frame(f, ahead, Stamp{t}, Stamp{t + 10 * kMs}, 0);
+  };
+  // Speed unknown: STOP, obstacle in zone, frame after frame.
+  for (int k = 0; k < 4; ++k) {
+    const auto& d = decide(k);
+    EXPECT_TRUE(d.stop) << k;
+    EXPECT_EQ(d.obstacles_in_zone, 1) << k;
+  }
+  // 1 m/s, fresh with every frame: the zone shrinks, and after the clear frames it is GO.
+  bool go = false;
+  for (int k = 4; k < 4 + cfg.safety.clear_frames + 1; ++k) {
+    stage.vehicle_speed(1.0, Stamp{t0 + (k + 1) * 100 * kMs});
+    const auto& d = decide(k);
+    EXPECT_EQ(d.obstacles_in_zone, 0) << k;
+    EXPECT_LT(d.zone.x_max_m, 9.5);
+    go = !d.stop;
+  }
+  EXPECT_TRUE(go);
+  // The bus falls silent: within the timeout the last speed still counts, past it the zone is full again.
+  const std::int64_t last_speed = t;
+  const int k_stale = 4 + cfg.safety.clear_frames + 1 + static_cast<int>(cfg.can.speed_timeout_s * 10.0) + 1;
+  const auto& d = decide(k_stale);
+  ASSERT_GT(t - last_speed, static_cast<std::int64_t>(cfg.can.speed_timeout_s * 1e9));
+  EXPECT_TRUE(d.stop);
+  EXPECT_EQ(d.obstacles_in_zone, 1);
+  EXPECT_GT(d.zone.x_max_m, 10.5);
 }
 
 }  // namespace

@@ -20,12 +20,17 @@ struct PipelineConfig {
 
 enum class CanSinkKind : std::uint8_t { SocketCan, Candump, None };
 
+// The tractor's speed read off the bus (output/can_speed.hpp) to size the stop zone.
+enum class SpeedInput : std::uint8_t { None, Ccvs1, IsoWheelBased };
+
 struct CanConfig {
   CanSinkKind sink = CanSinkKind::SocketCan;
   std::string interface = "can0";   // the SocketCAN interface; also the interface name written in a candump log
   std::string log_path;             // sink candump: the log file (relative paths from the config file's folder)
   output::CanParams params;         // source and controller addresses, obstacle messages per frame
   double heartbeat_period_s = 0.1;  // heartbeat (and repeated stop request) period
+  SpeedInput speed = SpeedInput::None;  // read from `interface` (SocketCAN) by the daemon
+  double speed_timeout_s = 0.5;     // an older speed is unknown: the zone has its full-speed length
 };
 
 }  // namespace fieldguard::app
