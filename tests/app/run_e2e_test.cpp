@@ -241,6 +241,9 @@ class RunE2e : public ::testing::Test {
     text = replaced(text, "\n  enabled: false\n  device: /dev/ttyUSB1\n", "\n  enabled: true\n  device: " + (dir.path() / "ahrs").string() + "\n");
     text = replaced(text, "\n  rate_hz: 5.0 ", "\n  rate_hz: 10.0 ");
     text = replaced(text, "\n      max: [12.0, 4.0, 1.0]", "\n      max: [6.0, 4.0, 1.0]");
+    // The tractor's speed from a bus this machine does not have (no SocketCAN): the daemon runs on with the
+    // zone at its full-speed length and says so.
+    text = replaced(text, "\n  speed: none ", "\n  speed: ccvs1 ");
     for (const char* s : {"scan2d", "gnss", "ahrs"}) {
       const std::string from = std::string("\n    ") + s + ":";
       const auto at = text.find(from, text.find("\n  sensors:"));
@@ -303,6 +306,7 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   if (fused) {
     // Every required sensor heard before the capture starts: the first rotations are decided, not waited for.
     ASSERT_TRUE(daemon.wait_for("frames fused from every enabled sensor", 5s)) << daemon.output();
+    EXPECT_TRUE(daemon.wait_for("the stop zone keeps its full-speed length", 5s)) << daemon.output();
     std::this_thread::sleep_for(1500ms);
   }
   {
@@ -377,6 +381,7 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   EXPECT_GE(entries, 3);
   // (c) after it leaves: STOP held for clear - 1 more rotations, GO once `clear` rotations were clear.
   int gos = 0;
+  int sensor_fault_frames = 0;
   for (int k = 0; k < kRotations - 1; ++k) {
     if (at(k) == Where::Inside && d.by_frame.count(k) != 0) {
       EXPECT_EQ(d.by_frame.at(k).command, 1) << "rotation " << k;
@@ -387,11 +392,22 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     bool far_long_enough = k >= clear;
     for (int j = k - clear + 1; far_long_enough && j <= k; ++j) far_long_enough = at(j) == Where::Far;
     if (far_long_enough && d.by_frame.count(k) != 0) {
+      const Stop& s = d.by_frame.at(k);
+      // Fused, a serial sensor the daemon did not hear for longer than its timeout (the AHRS's is 0.1 s) is a
+      // STOP of its own, right whatever the zone says: on this loaded 2-core machine the pseudo-terminals are
+      // sometimes not read for that long (README, Measurements). Such frames are counted, not held to GO.
+      if (fused && s.command == 1 && s.sensor_fault && !s.obstacle) {
+        ++sensor_fault_frames;
+        continue;
+      }
       ++gos;
-      EXPECT_EQ(d.by_frame.at(k).command, 0) << "rotation " << k << ": clear for " << clear << " rotations";
+      EXPECT_EQ(s.command, 0) << "rotation " << k << ": clear for " << clear << " rotations; reasons: obstacle "
+                              << s.obstacle << ", sensor fault " << s.sensor_fault << ", pipeline late "
+                              << s.pipeline_late << ", starting up " << s.starting_up;
     }
   }
   EXPECT_GE(gos, 20);
+  if (fused) std::printf("[ measured ] %d clear frames stopped for a silent serial sensor instead\n", sensor_fault_frames);
 
   // (b) silence: the last packet came at most one rotation after the last decided rotation's stamp (its
   // closing packet is older than its decision); STOP, sensor fault must follow within timeout + one frame.
