@@ -27,6 +27,7 @@
 #include "app/recording.hpp"
 #include "app/run_command.hpp"
 #include "app/sim_can_support.hpp"
+#include "support/shared_output.hpp"
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/drivers/velodyne_decoder.hpp"
@@ -61,15 +62,20 @@ class ReplayFusion : public ::testing::Test {
     dir_ = new fs::path(fs::temp_directory_path() / ("fg_fusion_" + std::to_string(::getpid())));
     fs::remove_all(*dir_);
     fs::create_directories(*dir_);
-    const std::string cmd = std::string("'") + FIELDGUARD_SIM + "' --scene uneven-drive --session '" +
-                            (*dir_ / "s").string() + "' --rotations " + std::to_string(kRotations) +
-                            " --seed 1 --quiet 2>&1";
-    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    // One session per build, shared by this suite's test processes (making it takes 20 s under ASan).
+    session_dir_ = new std::string(testing::shared_output(
+        FIELDGUARD_TEST_WORK, "uneven-drive-" + std::to_string(kRotations) + "-seed1-" + testing::stamp_of(FIELDGUARD_SIM),
+        [](const std::string& d) {
+          const std::string cmd = std::string("'") + FIELDGUARD_SIM + "' --scene uneven-drive --session '" + d +
+                                  "' --rotations " + std::to_string(kRotations) + " --seed 1 --quiet 2>&1";
+          return std::system(cmd.c_str()) == 0;
+        }));
+    ASSERT_FALSE(session_dir_->empty()) << "fieldguard-sim could not write the session";
     const auto loaded = load_config_file(std::string(FIELDGUARD_TEST_DATA) + "/fusion/uneven-drive.yaml");
     ASSERT_TRUE(loaded.ok()) << loaded.issues.front().to_string();
     config_ = new Config(loaded.config);
     truth_ = new Truth;
-    std::ifstream in(*dir_ / "s/pose.truth.jsonl");
+    std::ifstream in(session("pose.truth.jsonl"));
     std::string header;
     std::getline(in, header);
     const auto parsed = testing::JsonParser(header).parse();
@@ -91,10 +97,11 @@ class ReplayFusion : public ::testing::Test {
     std::error_code ec;
     fs::remove_all(*dir_, ec);
     delete dir_;
+    delete session_dir_;
     delete config_;
     delete truth_;
   }
-  static std::string session(const std::string& name) { return (*dir_ / "s" / name).string(); }
+  static std::string session(const std::string& name) { return (fs::path(*session_dir_) / name).string(); }
   static std::vector<LogFile> all_logs() {
     return {{session("scan2d.log"), LogKind::Scan2d}, {session("gnss.log"), LogKind::Gnss}, {session("ahrs.log"), LogKind::Ahrs}};
   }
@@ -124,11 +131,13 @@ class ReplayFusion : public ::testing::Test {
     return jobs;
   }
 
-  static fs::path* dir_;
+  static fs::path* dir_;  // this process's scratch
+  static std::string* session_dir_;
   static Config* config_;
   static Truth* truth_;
 };
 fs::path* ReplayFusion::dir_ = nullptr;
+std::string* ReplayFusion::session_dir_ = nullptr;
 Config* ReplayFusion::config_ = nullptr;
 Truth* ReplayFusion::truth_ = nullptr;
 
@@ -399,7 +408,7 @@ TEST_F(ReplayFusion, AGnssPositionJumpStopsTheTractorAsASensorFault) {
   ASSERT_TRUE(out->flush());
   ASSERT_NE(jump_us, 0) << "the session has fewer than 80 GGA sentences";
 
-  const StopLog clean = replay_stops((*dir_ / "s").string(), (*dir_).string());
+  const StopLog clean = replay_stops(*session_dir_, (*dir_).string());
   const StopLog jumped = replay_stops(bad.string(), bad.string());
   ASSERT_GT(clean.frames, 100U);
   EXPECT_EQ(jumped.frames, clean.frames);
@@ -440,7 +449,7 @@ TEST_F(ReplayFusion, LowBoxInFrontOfTheBumperIsFoundFromThe2dScanOnly) {
     const auto mx = o["max"].numbers();
     return mn.size() == 3 && mx.size() == 3 && mn[0] < 2.5 && mx[0] > 0.3 && mn[1] < 1.0 && mx[1] > -1.0;
   };
-  const auto with_scan = last_frames("--session '" + (*dir_ / "s").string() + "' --obstacles-out /dev/stdout", 20);
+  const auto with_scan = last_frames("--session '" + *session_dir_ + "' --obstacles-out /dev/stdout", 20);
   ASSERT_EQ(with_scan.size(), 20U);
   std::size_t found = 0;
   double worst_plane = 0.0;

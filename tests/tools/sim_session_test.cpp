@@ -26,6 +26,7 @@
 #include "sim/geodesy.hpp"
 #include "sim/scenes.hpp"
 #include "sim/simulator.hpp"
+#include "support/shared_output.hpp"
 #include "tools/tools_test_support.hpp"
 
 namespace fieldguard::sim {
@@ -82,11 +83,18 @@ Stats stats(const std::vector<double>& v) {
 class SimSession : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new tools_test::ScratchDir("session");
-    const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --session '" + dir_->file("s") + "' --rotations " +
+    // One session per build, shared by this suite's test processes (ctest runs each test in its own).
+    std::string errors;
+    dir_ = new std::string(testing::shared_output(
+        FIELDGUARD_TEST_WORK, "uneven-drive-" + std::to_string(kRotations) + "-seed3-" + testing::stamp_of(FIELDGUARD_SIM),
+        [&](const std::string& d) {
+          const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --session '" + d + "' --rotations " +
                                                        std::to_string(kRotations) + " --seed 3 --quiet");
-    ASSERT_EQ(r.exit_code, 0) << r.errors;
-    for (const auto& v : read_jsonl(dir_->file("s/pose.truth.jsonl"))) {
+          errors = r.errors;
+          return r.exit_code == 0;
+        }));
+    ASSERT_FALSE(dir_->empty()) << errors;
+    for (const auto& v : read_jsonl(path("pose.truth.jsonl"))) {
       if (v.find("session") != nullptr) {
         header_ = new score::JsonValue(*v.find("session"));
         continue;
@@ -99,13 +107,13 @@ class SimSession : public ::testing::Test {
     delete dir_;
     truth_.clear();
   }
-  static std::string path(const std::string& name) { return dir_->file("s/" + name); }
+  static std::string path(const std::string& name) { return *dir_ + "/" + name; }
 
-  static tools_test::ScratchDir* dir_;
+  static std::string* dir_;
   static score::JsonValue* header_;
   static std::map<std::string, std::vector<score::JsonValue>> truth_;
 };
-tools_test::ScratchDir* SimSession::dir_ = nullptr;
+std::string* SimSession::dir_ = nullptr;
 score::JsonValue* SimSession::header_ = nullptr;
 std::map<std::string, std::vector<score::JsonValue>> SimSession::truth_;
 
