@@ -137,6 +137,10 @@ void SensorFusion::rotations_to(Stamp host, std::vector<FrameJob>& out) {
 
 void SensorFusion::frames_to(Stamp host, std::vector<FrameJob>& out) {
   sync_->poll(host, frames_);
+  jobs_from_frames(host, out);
+}
+
+void SensorFusion::jobs_from_frames(Stamp host, std::vector<FrameJob>& out) {
   for (sync::SyncedFrame& f : frames_) {
     FrameJob& j = out.emplace_back();
     j.synced = std::move(f);
@@ -182,12 +186,7 @@ void SensorFusion::gnss(ByteSpan bytes, Stamp host, std::vector<FrameJob>& out) 
   const std::uint64_t now_rejected = dec_->nmea.counters().rejected() - dec_->nmea.counters().unsupported;
   counts_.gnss_errors += now_rejected - rejected;
   if (sync_) sync_->count_decode_errors(sync::SensorKind::Gnss, now_rejected - rejected);
-  for (nmea::Sentence& s : dec_->sentences) {
-    ++counts_.gnss;
-    check(s, host);
-    if (sync_ && inputs_.gnss) sync_->push_gnss(std::move(s), host);
-  }
-  dec_->sentences.clear();
+  pass_sentences(host);
   if (sync_) frames_to(host, out);
 }
 
@@ -197,6 +196,20 @@ void SensorFusion::ahrs(ByteSpan bytes, Stamp host, std::vector<FrameJob>& out) 
   const std::uint64_t now_rejected = dec_->xsens.counters().rejected();
   counts_.ahrs_errors += now_rejected - rejected;
   if (sync_) sync_->count_decode_errors(sync::SensorKind::Ahrs, now_rejected - rejected);
+  pass_items(host);
+  if (sync_) frames_to(host, out);
+}
+
+void SensorFusion::pass_sentences(Stamp host) {
+  for (nmea::Sentence& s : dec_->sentences) {
+    ++counts_.gnss;
+    check(s, host);
+    if (sync_ && inputs_.gnss) sync_->push_gnss(std::move(s), host);
+  }
+  dec_->sentences.clear();
+}
+
+void SensorFusion::pass_items(Stamp host) {
   for (xsens::StreamItem& it : dec_->items) {
     auto* m = std::get_if<xsens::MtData2>(&it);
     if (m == nullptr) continue;
@@ -205,7 +218,6 @@ void SensorFusion::ahrs(ByteSpan bytes, Stamp host, std::vector<FrameJob>& out) 
     if (sync_ && inputs_.ahrs) sync_->push_ahrs(std::move(*m), host);
   }
   dec_->items.clear();
-  if (sync_) frames_to(host, out);
 }
 
 void SensorFusion::poll(Stamp now, std::vector<FrameJob>& out) {
@@ -217,27 +229,11 @@ void SensorFusion::finish(Stamp now, std::vector<FrameJob>& out) {
   rotations_to(now, out);
   if (!sync_) return;
   dec_->nmea.finish(dec_->sentences);
-  for (nmea::Sentence& s : dec_->sentences) {
-    ++counts_.gnss;
-    if (inputs_.gnss) sync_->push_gnss(std::move(s), now);
-  }
-  dec_->sentences.clear();
+  pass_sentences(now);
   dec_->xsens.finish(dec_->items);
-  for (xsens::StreamItem& it : dec_->items) {
-    if (auto* m = std::get_if<xsens::MtData2>(&it)) {
-      ++counts_.ahrs;
-      if (inputs_.ahrs) sync_->push_ahrs(std::move(*m), now);
-    }
-  }
-  dec_->items.clear();
+  pass_items(now);
   sync_->finish(frames_);
-  for (sync::SyncedFrame& f : frames_) {
-    FrameJob& j = out.emplace_back();
-    j.synced = std::move(f);
-    j.complete = now;
-    ++counts_.frames;
-  }
-  frames_.clear();
+  jobs_from_frames(now, out);
 }
 
 void SensorFusion::check(const nmea::Sentence& s, Stamp host) {

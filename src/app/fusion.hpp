@@ -172,7 +172,10 @@ class SensorFusion {
  private:
   struct Decoders;
   void rotations_to(Stamp host, std::vector<FrameJob>& out);
-  void frames_to(Stamp host, std::vector<FrameJob>& out);
+  void frames_to(Stamp host, std::vector<FrameJob>& out);     // poll sync, then jobs_from_frames
+  void jobs_from_frames(Stamp host, std::vector<FrameJob>& out);  // frames_ out as jobs complete at `host`
+  void pass_sentences(Stamp host);  // decoded NMEA: counted, checked, to sync
+  void pass_items(Stamp host);      // decoded MTData2: likewise
 
   void check(const nmea::Sentence& s, Stamp host);
   void check(const xsens::MtData2& m, Stamp host);
