@@ -29,11 +29,13 @@ using namespace fieldguard::geo;
 constexpr std::int64_t kT0 = 1'718'449'170'000'000'000;
 Stamp at_s(double s) { return Stamp{kT0 + std::llround(s * 1e9)}; }
 
-std::vector<LidarPoint> rotation_139k() {
+// One 0.2 s rotation of a 32-beam sensor with `firings` firings: 4344 (139,008 points, 5 Hz HDL-32E
+// density) or 2172 (69,504).
+std::vector<LidarPoint> synthetic_rotation(int firings) {
   std::vector<LidarPoint> pts;
-  pts.reserve(139008);
-  for (int f = 0; f < 4344; ++f) {
-    const double az = 2.0 * std::numbers::pi * f / 4344.0;
+  pts.reserve(static_cast<std::size_t>(firings) * 32);
+  for (int f = 0; f < firings; ++f) {
+    const double az = 2.0 * std::numbers::pi * f / firings;
     for (int l = 0; l < 32; ++l) {
       const double el = (-30.67 + 1.33 * l) * std::numbers::pi / 180.0;
       const double r = 5.0 + 40.0 * std::fabs(std::sin(3.0 * az + l));
@@ -41,13 +43,15 @@ std::vector<LidarPoint> rotation_139k() {
       p.x = static_cast<float>(r * std::cos(el) * std::cos(az));
       p.y = static_cast<float>(r * std::cos(el) * std::sin(az));
       p.z = static_cast<float>(r * std::sin(el));
-      p.time_s = static_cast<float>(0.2 * (f + l / 32.0) / 4344.0);
+      p.time_s = static_cast<float>(0.2 * (f + l / 32.0) / firings);
       p.ring = static_cast<std::uint16_t>(l);
       pts.push_back(p);
     }
   }
   return pts;
 }
+
+std::vector<LidarPoint> rotation_139k() { return synthetic_rotation(4344); }
 
 PoseTrack rocking_track() {
   PoseTrack track;
@@ -159,21 +163,7 @@ sync::SyncedFrame frame_70k() {
   f.window_start = at_s(0.0);
   f.window_end = at_s(0.2);
   f.rotations = 1;
-  f.points.reserve(69504);
-  for (int firing = 0; firing < 2172; ++firing) {
-    const double az = 2.0 * std::numbers::pi * firing / 2172.0;
-    for (int l = 0; l < 32; ++l) {
-      const double el = (-30.67 + 1.33 * l) * std::numbers::pi / 180.0;
-      const double r = 5.0 + 40.0 * std::fabs(std::sin(3.0 * az + l));
-      LidarPoint p;
-      p.x = static_cast<float>(r * std::cos(el) * std::cos(az));
-      p.y = static_cast<float>(r * std::cos(el) * std::sin(az));
-      p.z = static_cast<float>(r * std::sin(el));
-      p.time_s = static_cast<float>(0.2 * (firing + l / 32.0) / 2172.0);
-      p.ring = static_cast<std::uint16_t>(l);
-      f.points.push_back(p);
-    }
-  }
+  f.points = synthetic_rotation(2172);
   for (int i = 0; i < 20; ++i) {
     const double t = -0.0025 + 0.0105 * i;  // ~95 Hz over the window (the last 2.5 ms before its end)
     xsens::MtData2 d;
