@@ -22,12 +22,14 @@ using kernels::azimuth_ring_word;
 using kernels::azimuth_table;
 using kernels::load4;
 using kernels::load_le16_unchecked;
+using kernels::load_le32_unchecked;
 using kernels::put_point;
 using kernels::round_cdeg;
 using kernels::round_cdeg_lround;
 using kernels::return_type_word;
 using kernels::transpose4;
 using kernels::Vec4f;
+using kernels::Vec4i;
 using kernels::wrap_cdeg;
 using kernels::wrap_cdeg_fast;
 
@@ -126,7 +128,7 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
 
   const Layout& lay = layout_of(options_.model);
   block_us_ = lay.block_us;
-  // Summed in the same order as the point times in decode_points(), so that the marked firing is exactly 0.
+  // Summed in the same order as the point times (group_time_s_, below), so that the marked firing is exactly 0.
   const float in_block_last = static_cast<float>(lay.sequences - 1) * lay.sequence_us +
                               static_cast<float>(lay.lasers - 1) * lay.firing_us;
   last_firing_single_us_ = static_cast<float>(kBlocksPerPacket - 1) * lay.block_us + in_block_last;
@@ -150,6 +152,19 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
     slots_.ring[slot] = static_cast<std::uint16_t>(ring < 0 ? 0 : ring);
     if (!(std::abs(slots_.rot_cdeg[slot]) < 35000.F)) fast_wrap_ = false;
   }
+  // Point times relative to the firing the packet timestamp marks, per firing group and slot.
+  for (std::size_t dual = 0; dual < 2; ++dual) {
+    const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring
+                             ? (dual != 0 ? last_firing_dual_us_ : last_firing_single_us_)
+                             : 0.F;
+    const std::size_t groups = dual != 0 ? kBlocksPerPacket / 2 : kBlocksPerPacket;
+    for (std::size_t g = 0; g < groups; ++g) {
+      const float group_us = static_cast<float>(g) * block_us_;
+      for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {
+        group_time_s_[dual][g * kSlotsPerBlock + slot] = ((group_us + slots_.in_block_us[slot]) - ref_us) * 1e-6F;
+      }
+    }
+  }
 }
 
 namespace {
@@ -171,7 +186,8 @@ struct BlockPoints {
 struct GroupAngles {
   alignas(16) std::array<float, kSlotsPerBlock> cos_a;
   alignas(16) std::array<float, kSlotsPerBlock> sin_a;
-  alignas(16) std::array<float, kSlotsPerBlock> time_s;
+  // The firing time of each slot: the group's row of Decoder::group_time_s_.
+  const float* time_s;
   alignas(16) std::array<std::uint32_t, kSlotsPerBlock> azimuth_ring;  // azimuth_ring_word() of each slot
 };
 
@@ -188,10 +204,7 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
   constexpr std::size_t kGroups = kBlocksPerPacket / kStep;  // firing groups per packet
   constexpr std::size_t kSlots = kSlotsPerBlock;
 
-  // Time of the firing the packet timestamp marks, relative to block 0 slot 0.
-  const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring
-                           ? (kDual ? last_firing_dual_us_ : last_firing_single_us_)
-                           : 0.F;
+  const float* const group_times = kDual ? group_time_s_[1].data() : group_time_s_[0].data();
 
   // Azimuth of each group and its step to the next group (the last group reuses the previous step).
   std::array<int, kGroups> az_int{};
@@ -219,7 +232,7 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
 
   // Azimuth of every firing of group g, its cos/sin and the firing time.
   auto group_angles = [&](std::size_t g, GroupAngles& out) {
-    const float group_us = static_cast<float>(g) * block_us_;
+    out.time_s = group_times + g * kSlots;
     const float az_g = az[g];
     const float delta_g = delta[g];
     if constexpr (kFastWrap) {
@@ -232,7 +245,6 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
         index[s] = i;
         frac[s] = f;
         out.azimuth_ring[s] = azimuth_ring_word(round_cdeg(i, f), t.ring[s]);
-        out.time_s[s] = ((group_us + t.in_block_us[s]) - ref_us) * 1e-6F;
       }
       // The table look-up, four slots at a time: four entries (cos, sin, dcos, dsin) transposed into a vector of
       // each, then entry + fraction * step (the same float operations as one slot at a time).
@@ -256,16 +268,22 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
         out.cos_a[s] = std::cos(angle);
         out.sin_a[s] = std::sin(angle);
         out.azimuth_ring[s] = azimuth_ring_word(round_cdeg_lround(w), t.ring[s]);
-        out.time_s[s] = ((group_us + t.in_block_us[s]) - ref_us) * 1e-6F;
       }
     }
   };
 
   // The returns of one block (kSlots of them at `b`) into points, all slots, in range or not.
   auto block_points = [&](const std::uint8_t* b, const GroupAngles& ga, BlockPoints& out) {
-    for (std::size_t s = 0; s < kSlots; ++s) {
-      out.raw[s] = load_le16_unchecked(b + 3 * s);
-      out.intensity[s] = b[3 * s + 2];
+    // Four slots at a time: each slot's 3 bytes and the next one as a little-endian u32 (distance in the low 16
+    // bits, reflectivity in the next 8), split by masks. The last slot's 4th byte is the next block's flag, or
+    // the timestamp after the last block: inside the checked 1206 bytes.
+    for (std::size_t s = 0; s < kSlots; s += 4) {
+      const Vec4i v = {load_le32_unchecked(b + 3 * s), load_le32_unchecked(b + 3 * s + 3),
+                       load_le32_unchecked(b + 3 * s + 6), load_le32_unchecked(b + 3 * s + 9)};
+      const Vec4i raw = v & 0xFFFF;
+      const Vec4i intensity = (v >> 16) & 0xFF;
+      std::memcpy(&out.raw[s], &raw, sizeof raw);
+      std::memcpy(&out.intensity[s], &intensity, sizeof intensity);
     }
     for (std::size_t s = 0; s < kSlots; ++s) {
       const float d = static_cast<float>(out.raw[s]) * res + t.dist_m[s];
@@ -286,7 +304,7 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
                     std::array<Vec4f, 4>& first, std::array<Vec4f, 4>& second) {
     first = {load4(&bp.x[s]), load4(&bp.y[s]), load4(&bp.z[s]), load4(&bp.intensity_f[s])};
     transpose4(first[0], first[1], first[2], first[3]);
-    second = {load4(&ga.time_s[s]), load4(&bp.range[s]), load4(&ga.azimuth_ring[s]), type};
+    second = {load4(ga.time_s + s), load4(&bp.range[s]), load4(&ga.azimuth_ring[s]), type};
     transpose4(second[0], second[1], second[2], second[3]);
   };
 

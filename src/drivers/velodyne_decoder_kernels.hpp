@@ -94,9 +94,23 @@ inline std::uint16_t load_le16_unchecked(const std::uint8_t* p) {
   }
 }
 
+// A little-endian u32 at p (the caller checked that 4 bytes are there), as a signed 32-bit value: the decoder
+// keeps only its low 24 bits.
+inline std::int32_t load_le32_unchecked(const std::uint8_t* p) {
+  std::uint32_t v = 0;
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(&v, p, sizeof v);
+  } else {
+    v = static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8U) |
+        (static_cast<std::uint32_t>(p[2]) << 16U) | (static_cast<std::uint32_t>(p[3]) << 24U);
+  }
+  return static_cast<std::int32_t>(v);
+}
+
 // Four floats in one vector register: the vector extension of GCC and Clang, lowered to SSE2 on x86-64, NEON on
 // ARM, scalar code elsewhere; no -march needed. __builtin_shufflevector: GCC 12 and later, Clang.
 using Vec4f = float __attribute__((vector_size(16)));
+using Vec4i = std::int32_t __attribute__((vector_size(16)));
 
 inline Vec4f load4(const void* p) {
   Vec4f v;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -30,19 +31,38 @@ struct BoxBounds {
   return true;
 }
 
+// A box's bounds, each splatted across four lanes: one axis of four points at a time.
+struct BoxLanes {
+  simd::f32x4 lo_x, lo_y, lo_z, hi_x, hi_y, hi_z;
+  explicit BoxLanes(const Box3& b)
+      : lo_x(simd::splat(static_cast<float>(b.min[0]))),
+        lo_y(simd::splat(static_cast<float>(b.min[1]))),
+        lo_z(simd::splat(static_cast<float>(b.min[2]))),
+        hi_x(simd::splat(static_cast<float>(b.max[0]))),
+        hi_y(simd::splat(static_cast<float>(b.max[1]))),
+        hi_z(simd::splat(static_cast<float>(b.max[2]))) {}
+  // Lane k all ones where point k is inside (closed): the same comparisons as BoxBounds::contains(), so the
+  // same answer for every float, NaN included (never inside).
+  [[nodiscard]] simd::i32x4 contains(simd::f32x4 x, simd::f32x4 y, simd::f32x4 z) const {
+    return (x >= lo_x) & (x <= hi_x) & (y >= lo_y) & (y <= hi_y) & (z >= lo_z) & (z <= hi_z);
+  }
+};
+
 // Copies the points of in[0, n) that are inside `keep` and outside `drop` to x, y, z, ring (each with room
 // for n), in order, and returns how many. Branch-free: every point is written at the next free place, which
 // moves on only when the point is kept, so the ROI's edge cutting through a rotation costs no mispredictions.
 // `keep` must be finite (it then rejects NaN and infinity); with `check_finite` the points are also tested.
 // With `split`, the 2D LiDAR's points are not kept but appended to `scan2d` (a rare, well-predicted branch).
+// The box tests run on four points at a time (their x, y, z transposed into a vector each), which leaves the
+// copy as most of the per-point work; the last n % 4 points, and any four that hold a 2D LiDAR point, one by one.
 template <bool check_finite, bool split>
 inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBounds& keep, const BoxBounds& drop,
-                               float* x, float* y, float* z, std::uint16_t* ring, std::vector<LidarPoint>* scan2d) {
+                               const BoxLanes& keep4, const BoxLanes& drop4, float* x, float* y, float* z,
+                               std::uint16_t* ring, std::vector<LidarPoint>* scan2d) {
   static_assert(offsetof(LidarPoint, x) == 0 && offsetof(LidarPoint, y) == 4 && offsetof(LidarPoint, z) == 8 &&
                 offsetof(LidarPoint, intensity) == 12);
   std::size_t k = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const LidarPoint& p = in[i];
+  const auto one = [&](const LidarPoint& p) {
     const simd::f32x4 v = simd::load(&p.x);  // x, y, z, intensity
     bool kept = keep.contains(v) && !drop.contains(v);
     if constexpr (check_finite) kept = kept && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
@@ -58,7 +78,46 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
     z[k] = p.z;
     ring[k] = p.ring;
     k += kept ? 1U : 0U;
+  };
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const LidarPoint* const p = in + i;
+    if constexpr (split) {
+      constexpr auto k2d = static_cast<std::uint8_t>(PointSource::Lidar2d);
+      if ((p[0].source == k2d) | (p[1].source == k2d) | (p[2].source == k2d) | (p[3].source == k2d)) [[unlikely]] {
+        for (std::size_t j = 0; j < 4; ++j) one(p[j]);
+        continue;
+      }
+    }
+    simd::f32x4 px = simd::load(&p[0].x);
+    simd::f32x4 py = simd::load(&p[1].x);
+    simd::f32x4 pz = simd::load(&p[2].x);
+    simd::f32x4 pi = simd::load(&p[3].x);
+    simd::transpose4(px, py, pz, pi);
+    simd::i32x4 in_box = keep4.contains(px, py, pz) & ~drop4.contains(px, py, pz);
+    if constexpr (check_finite) {
+      // |v| <= FLT_MAX: false for infinity and NaN, as !std::isfinite.
+      const simd::f32x4 big = simd::splat(std::numeric_limits<float>::max());
+      const simd::i32x4 abs_bits = simd::splat(0x7FFFFFFF);
+      const auto abs = [&](simd::f32x4 v) {
+        simd::i32x4 b;
+        std::memcpy(&b, &v, sizeof b);
+        b &= abs_bits;
+        std::memcpy(&v, &b, sizeof v);
+        return v;
+      };
+      in_box &= (abs(px) <= big) & (abs(py) <= big) & (abs(pz) <= big);
+    }
+    const unsigned bits = simd::mask_bits(in_box);
+    for (std::size_t j = 0; j < 4; ++j) {
+      x[k] = p[j].x;
+      y[k] = p[j].y;
+      z[k] = p[j].z;
+      ring[k] = p[j].ring;
+      k += (bits >> j) & 1U;
+    }
   }
+  for (; i < n; ++i) one(in[i]);
   return k;
 }
 
@@ -75,11 +134,12 @@ void crop(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Clo
   out.z.resize(n);
   out.ring.resize(n);
   const BoxBounds keep(roi), drop(body);
+  const BoxLanes keep4(roi), drop4(body);
   // A finite ROI already rejects NaN and infinity; only an unbounded one needs the explicit test.
-  const std::size_t k = is_finite(roi) ? crop_points<false, split>(in.data(), n, keep, drop, out.x.data(), out.y.data(),
-                                                                   out.z.data(), out.ring.data(), scan2d)
-                                       : crop_points<true, split>(in.data(), n, keep, drop, out.x.data(), out.y.data(),
-                                                                  out.z.data(), out.ring.data(), scan2d);
+  const std::size_t k = is_finite(roi) ? crop_points<false, split>(in.data(), n, keep, drop, keep4, drop4, out.x.data(),
+                                                                   out.y.data(), out.z.data(), out.ring.data(), scan2d)
+                                       : crop_points<true, split>(in.data(), n, keep, drop, keep4, drop4, out.x.data(),
+                                                                  out.y.data(), out.z.data(), out.ring.data(), scan2d);
   out.x.resize(k);
   out.y.resize(k);
   out.z.resize(k);

@@ -102,25 +102,6 @@ __attribute__((noinline, cold)) void VoxelGrid::grow_table() {
   }
 }
 
-inline std::uint32_t VoxelGrid::find_or_insert(std::uint64_t key) {
-  std::uint32_t h = slot_of(key, shift_);
-  for (;;) {
-    const std::uint32_t id = table_[h] - base_;
-    if (id >= voxels_) break;  // empty in this frame
-    if (keys_[id] == key) return id;
-    h = (h + 1) & mask_;
-  }
-  const std::uint32_t id = voxels_++;
-  keys_[id] = key;
-  sums_[id] = Sum{0.F, 0.F, 0.F, 0};
-  if (static_cast<std::size_t>(voxels_) * 2 > table_.size()) [[unlikely]] {
-    grow_table();  // re-inserts every key, this one included
-  } else {
-    table_[h] = base_ + id;
-  }
-  return id;
-}
-
 void VoxelGrid::begin(std::size_t max_points) {
   // Ids of this frame start after the last frame's; when they would run out of 32 bits, the table is cleared.
   const std::uint64_t next = static_cast<std::uint64_t>(base_) + voxels_ + max_points + 1;
@@ -146,19 +127,27 @@ void VoxelGrid::begin(std::size_t max_points) {
 
 // One point into the voxel `key`: into its ring's cache entry while the ring stays in one voxel. When it
 // moves on, the finished run (key, sums, count) is queued; queued runs meet the table in batches.
-inline void VoxelGrid::add(std::uint64_t key, std::uint32_t ring, simd::f32x4 p) {
+// `queued` is the caller's copy of queued_, in a register: as a member, every point would load and store it
+// (the runs' 32-bit stores may alias it), a store-to-load chain through memory from one point to the next.
+inline void VoxelGrid::add(std::uint64_t key, std::uint32_t ring, simd::f32x4 p, std::uint32_t& queued) {
   CacheEntry& c = cache_[ring & (kRingCache - 1)];
   // Without branches on the data (whether a ring stays in its voxel is a coin flip for the predictor): the
   // entry's run is written to the queue every time, and the queue moves on only when the run has finished.
   const bool moved = c.key != key;
-  runs_[queued_] = Run{c.sum, c.key, c.n, 0};
-  queued_ += (moved && c.key != kNoKey) ? 1U : 0U;
+  Run& r = runs_[queued];
+  r.sum = c.sum;
+  r.key = c.key;
+  r.n = c.n;
+  queued += (moved && c.key != kNoKey) ? 1U : 0U;
   const simd::f32x4 keep = moved ? simd::splat(0.F) : c.sum;
   c.sum = keep + p;  // lanes x, y, z (the fourth is not used)
   c.n = moved ? 1U : c.n + 1U;
   c.key = key;
-  if (queued_ == kRunBatch) [[unlikely]]
+  if (queued == kRunBatch) [[unlikely]] {
+    queued_ = queued;
     drain_runs();
+    queued = 0;
+  }
 }
 
 inline void VoxelGrid::queue_run(const CacheEntry& c) {
@@ -168,18 +157,52 @@ inline void VoxelGrid::queue_run(const CacheEntry& c) {
 
 // The queued runs into their voxels, in queue order (so the voxel ids, and the output order, depend only on
 // the input). Two passes, each fetching a few runs ahead: the table slots, then the voxels' sums. A run's
-// lookup would otherwise wait on memory while nothing else can go on.
+// lookup would otherwise wait on memory while nothing else can go on. The table's state is read into locals
+// once: as members, each would be loaded again after every 32-bit store to the table or a sum (may alias).
 void VoxelGrid::drain_runs() {
   constexpr std::uint32_t kAhead = 6;
-  for (std::uint32_t j = 0; j < queued_; ++j) {
-    if (j + kAhead < queued_) __builtin_prefetch(&table_[slot_of(runs_[j + kAhead].key, shift_)]);
+  const std::uint32_t queued = queued_;
+  std::uint32_t* table = table_.data();
+  std::uint32_t mask = mask_;
+  std::uint32_t shift = shift_;
+  std::uint32_t base = base_;
+  std::uint32_t voxels = voxels_;
+  std::uint64_t* const keys = keys_.data();
+  Sum* const sums = sums_.data();
+  for (std::uint32_t j = 0; j < queued; ++j) {
+    if (j + kAhead < queued) __builtin_prefetch(&table[slot_of(runs_[j + kAhead].key, shift)]);
     Run& r = runs_[j];
-    r.id = find_or_insert(r.key);
+    const std::uint64_t key = r.key;
+    std::uint32_t h = slot_of(key, shift);
+    std::uint32_t id = 0;
+    for (;;) {
+      id = table[h] - base;
+      if (id >= voxels) break;  // empty in this frame
+      if (keys[id] == key) break;
+      h = (h + 1) & mask;
+    }
+    if (id >= voxels) {  // a new voxel
+      id = voxels++;
+      keys[id] = key;
+      sums[id] = Sum{0.F, 0.F, 0.F, 0};
+      if (static_cast<std::size_t>(voxels) * 2 > table_.size()) [[unlikely]] {
+        voxels_ = voxels;
+        grow_table();  // re-inserts every key, this one included
+        table = table_.data();
+        mask = mask_;
+        shift = shift_;
+        base = base_;
+      } else {
+        table[h] = base + id;
+      }
+    }
+    r.id = id;
   }
-  for (std::uint32_t j = 0; j < queued_; ++j) {
-    if (j + kAhead < queued_) __builtin_prefetch(&sums_[runs_[j + kAhead].id], 1);
+  voxels_ = voxels;
+  for (std::uint32_t j = 0; j < queued; ++j) {
+    if (j + kAhead < queued) __builtin_prefetch(&sums[runs_[j + kAhead].id], 1);
     const Run& r = runs_[j];
-    Sum& a = sums_[r.id];
+    Sum& a = sums[r.id];
     a.x += r.sum[0];
     a.y += r.sum[1];
     a.z += r.sum[2];
@@ -210,24 +233,39 @@ void VoxelGrid::finish(Cloud& out) {
 void VoxelGrid::add_points(const float* px, const float* py, const float* pz, const std::uint16_t* ring,
                            std::size_t n) {
   std::uint64_t keys[kBlock];
+  simd::f32x4 points[kBlock];  // (x, y, z, 0) of each point of the block
   float tx[kBlock] = {}, ty[kBlock] = {}, tz[kBlock] = {};
+  std::uint32_t queued = queued_;
   for (std::size_t base = 0; base < n; base += kBlock) {
     const std::size_t m = std::min(kBlock, n - base);
+    const float* bx = px + base;
+    const float* by = py + base;
+    const float* bz = pz + base;
+    if (m < kBlock) {  // the tail, through a padded copy
+      std::copy_n(bx, m, tx);
+      std::copy_n(by, m, ty);
+      std::copy_n(bz, m, tz);
+      bx = tx;
+      by = ty;
+      bz = tz;
+    }
     if (coarse_) {
-      for (std::size_t j = 0; j < m; ++j) keys[j] = coarse_key(px[base + j], py[base + j], pz[base + j]);
-    } else if (m == kBlock) {
-      block_keys(px + base, py + base, pz + base, inv_[1], keys);
-    } else {  // the tail, through a padded copy
-      std::copy_n(px + base, m, tx);
-      std::copy_n(py + base, m, ty);
-      std::copy_n(pz + base, m, tz);
-      block_keys(tx, ty, tz, inv_[1], keys);
+      for (std::size_t j = 0; j < m; ++j) keys[j] = coarse_key(bx[j], by[j], bz[j]);
+    } else {
+      block_keys(bx, by, bz, inv_[1], keys);
     }
-    for (std::size_t j = 0; j < m; ++j) {
-      const std::size_t i = base + j;
-      add(keys[j], ring != nullptr ? ring[i] : 0U, simd::f32x4{px[i], py[i], pz[i], 0.F});
+    // Four points' coordinates at a time into one vector each, by a transpose rather than point by point.
+    for (std::size_t b = 0; b < kBlock; b += 4) {
+      simd::f32x4 x = simd::load(bx + b), y = simd::load(by + b), z = simd::load(bz + b), w = simd::splat(0.F);
+      simd::transpose4(x, y, z, w);
+      points[b] = x;
+      points[b + 1] = y;
+      points[b + 2] = z;
+      points[b + 3] = w;
     }
+    for (std::size_t j = 0; j < m; ++j) add(keys[j], ring != nullptr ? ring[base + j] : 0U, points[j], queued);
   }
+  queued_ = queued;
 }
 
 void VoxelGrid::filter(const Cloud& in, Cloud& out) {

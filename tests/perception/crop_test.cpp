@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "perception/test_clouds.hpp"
@@ -100,6 +103,69 @@ TEST(CropBox, SetsTheScanOfAMergedFrameAside) {
   crop_box(only3d, kRoi, kBody, out, scan);
   EXPECT_TRUE(scan.empty());
   EXPECT_EQ(out.size(), expected.size());
+}
+
+// The box tests run four points at a time; every point must get the answer of the plain per-point test, whatever
+// its place in a group of four: random points on and around every face of both boxes, NaN and infinity in any
+// coordinate, 2D LiDAR points among them, counts that leave a remainder, a finite and an unbounded ROI.
+TEST(CropBox, FourAtATimeMatchesThePointByPointTest) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const double dinf = std::numeric_limits<double>::infinity();
+  const Box3 half_open{{-10.0, -dinf, -1.5}, {50.0, 10.0, dinf}};
+  std::mt19937 rng(7);
+  // Coordinates drawn from the faces of both boxes, just beside them, the middle, and the non-finite.
+  const std::vector<float> xs = {-10.F, -10.01F, 50.F, 50.01F, -5.F, 0.4F, 0.41F, -1.F, 20.F, nan, inf, -inf};
+  const std::vector<float> ys = {-10.F, -10.01F, 10.F, 10.01F, -1.5F, 1.5F, 1.51F, 0.F, 5.F, nan, inf, -inf};
+  const std::vector<float> zs = {-1.5F, -1.51F, 6.F, 6.01F, 1.5F, 1.51F, 0.F, 3.F, nan, inf, -inf};
+  const auto pick = [&](const std::vector<float>& v) { return v[rng() % v.size()]; };
+  const auto inside = [](const Box3& b, const LidarPoint& p) {
+    const std::array<float, 3> c = {p.x, p.y, p.z};
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (!(c[a] >= static_cast<float>(b.min[a]) && c[a] <= static_cast<float>(b.max[a]))) return false;
+    }
+    return true;
+  };
+  for (const Box3& roi : {kRoi, half_open}) {
+    for (std::size_t n : {0U, 1U, 3U, 4U, 5U, 7U, 64U, 1001U}) {
+      std::vector<LidarPoint> in;
+      for (std::size_t i = 0; i < n; ++i) {
+        in.push_back(lidar_point(pick(xs), pick(ys), pick(zs), static_cast<std::uint16_t>(i)));
+        if (rng() % 9 == 0) in.back().source = static_cast<std::uint8_t>(PointSource::Lidar2d);
+      }
+      std::vector<std::uint16_t> want, want2d;
+      for (const LidarPoint& p : in) {
+        if (p.source == static_cast<std::uint8_t>(PointSource::Lidar2d)) {
+          want2d.push_back(p.ring);
+        } else if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && inside(roi, p) &&
+                   !inside(kBody, p)) {
+          want.push_back(p.ring);
+        }
+      }
+      Cloud out;
+      std::vector<LidarPoint> scan;
+      crop_box(in, roi, kBody, out, scan);
+      EXPECT_EQ(std::vector<std::uint16_t>(out.ring.begin(), out.ring.end()), want) << n << " points";
+      std::vector<std::uint16_t> got2d;
+      for (const LidarPoint& p : scan) got2d.push_back(p.ring);
+      EXPECT_EQ(got2d, want2d) << n << " points";
+      for (std::size_t k = 0; k < out.size(); ++k) {
+        const LidarPoint& p = in[out.ring[k]];
+        EXPECT_EQ(out.x[k], p.x);
+        EXPECT_EQ(out.y[k], p.y);
+        EXPECT_EQ(out.z[k], p.z);
+      }
+      // Without the 2D split: the 2D points are cropped as any other.
+      std::vector<std::uint16_t> want_all;
+      for (const LidarPoint& p : in) {
+        if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && inside(roi, p) && !inside(kBody, p)) {
+          want_all.push_back(p.ring);
+        }
+      }
+      crop_box(in, roi, kBody, out);
+      EXPECT_EQ(std::vector<std::uint16_t>(out.ring.begin(), out.ring.end()), want_all) << n << " points";
+    }
+  }
 }
 
 }  // namespace

@@ -86,6 +86,9 @@ class Decoder {
     std::array<std::uint16_t, kSlotsPerBlock> ring;
   };
   SlotTables slots_{};
+  // Time of each firing of a packet (s), relative to the firing the packet timestamp marks: [0] single return
+  // (12 firing groups), [1] dual (6); row g of 32 slots per group. Precomputed: the same floats for every packet.
+  std::array<std::array<float, kBlocksPerPacket * kSlotsPerBlock>, 2> group_time_s_{};
   float block_us_ = 0.F;
   float last_firing_single_us_ = 0.F;  // the last firing of a packet after its first, single / dual return
   float last_firing_dual_us_ = 0.F;

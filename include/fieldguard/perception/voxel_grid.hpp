@@ -51,13 +51,12 @@ class VoxelGrid {
   static constexpr std::uint32_t kRunBatch = 64;
 
   void begin(std::size_t max_points);
-  void add(std::uint64_t key, std::uint32_t ring, Vec4 p);
+  void add(std::uint64_t key, std::uint32_t ring, Vec4 p, std::uint32_t& queued);
   void add_points(const float* x, const float* y, const float* z, const std::uint16_t* ring, std::size_t n);
   void queue_run(const CacheEntry& c);
   void drain_runs();
   void finish(Cloud& out);
   void grow_table();
-  [[nodiscard]] std::uint32_t find_or_insert(std::uint64_t key);
   [[nodiscard]] std::uint64_t coarse_key(float x, float y, float z) const;
 
   VoxelParams params_;
