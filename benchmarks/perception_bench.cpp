@@ -48,6 +48,7 @@
 
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
+#include "fieldguard/perception/cluster_absorb.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/near_field.hpp"
@@ -404,6 +405,41 @@ void BM_ClusterFixedGrid(benchmark::State& state) {
 void BM_ClusterAdaptiveGrid(benchmark::State& state) {
   cluster_bench(state, "cluster: adaptive, grid", ClusterMethod::Adaptive, ClusterStructure::Grid);
 }
+// fieldguard.yaml's clustering as configured (anisotropic radii from its tolerance_m), then its small-cluster
+// absorption (cluster_absorb.hpp; no PCL counterpart) on those clusters.
+void BM_ClusterAnisotropicGrid(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  ClusterParams cp = fieldguard_params().cluster;
+  cp.method = ClusterMethod::Anisotropic;
+  cp.structure = ClusterStructure::Grid;
+  EuclideanClusterer clusterer(cp);
+  Clusters out;
+  paired(
+      state, "cluster: anisotropic, grid", static_cast<int>(state.range(0)), f.above.size(),
+      [&] {
+        clusterer.extract(f.above, out);
+        benchmark::DoNotOptimize(out.indices.data());
+      },
+      [&] { pcl_clusters(f.pcl_above, 0.6, 1, 1000000); });
+}
+void BM_ClusterAbsorb(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const ClusterParams cp = fieldguard_params().cluster;
+  EuclideanClusterer clusterer(cp);
+  Clusters clustered, work;
+  clusterer.extract(f.above, clustered);
+  ClusterAbsorber absorber(cp.absorb_max_points > 0 ? cp.absorb_max_points : 10, cp.absorb_margin_m);
+  std::uint32_t moved = 0;
+  paired(state, "cluster absorb", static_cast<int>(state.range(0)), f.above.size(),
+         [&] {
+           work = clustered;  // the stage rewrites its input: timed with this copy
+           moved = absorber.absorb(f.above, work);
+           benchmark::DoNotOptimize(work.indices.data());
+         },
+         {});
+  state.counters["clusters_in"] = static_cast<double>(clustered.size());
+  state.counters["absorbed"] = static_cast<double>(moved);
+}
 
 void pipeline_bench(benchmark::State& state, const char* stage, const PipelineParams& params) {
   Frame& f = frame(static_cast<int>(state.range(0)));
@@ -419,6 +455,17 @@ void pipeline_bench(benchmark::State& state, const char* stage, const PipelinePa
 void BM_PipelinePublished(benchmark::State& state) { pipeline_bench(state, "PIPELINE published.yaml", published()); }
 void BM_PipelineFieldguard(benchmark::State& state) {
   pipeline_bench(state, "PIPELINE fieldguard.yaml", fieldguard_params());
+}
+// fieldguard.yaml's pipeline without the crop-canopy rule (canopy.hpp) and the radial ground blend
+// (ZoneParams::blend_radial): their cost is BM_PipelineFieldguard's time minus this one's.
+void BM_PipelineFieldguardNoCanopy(benchmark::State& state) {
+  static const PipelineParams p = [] {
+    PipelineParams q = fieldguard_params();
+    q.filters.canopy_max_height_m = 0.0;
+    q.ground.zones.blend_radial = false;
+    return q;
+  }();
+  pipeline_bench(state, "PIPELINE fieldguard.yaml without canopy rule, ground blend", p);
 }
 
 // Packets to obstacles: the UDP payloads of the rotation into velodyne::Stream, the rotation it emits through
@@ -561,8 +608,11 @@ FG_BENCH(BM_GroundZones);
 FG_BENCH(BM_ClusterFixedKdTree);
 FG_BENCH(BM_ClusterFixedGrid);
 FG_BENCH(BM_ClusterAdaptiveGrid);
+FG_BENCH(BM_ClusterAnisotropicGrid);
+FG_BENCH(BM_ClusterAbsorb);
 FG_BENCH(BM_PipelinePublished);
 FG_BENCH(BM_PipelineFieldguard);
+FG_BENCH(BM_PipelineFieldguardNoCanopy);
 FG_BENCH(BM_Decode);
 FG_BENCH(BM_PacketsToObstacles);
 FG_BENCH(BM_NearField);

@@ -175,7 +175,7 @@ void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
   if (!r.section(z, path,
                  {"edges_m", "rings", "sectors", "min_bin_points", "seed_lowest", "seed_margin_m", "fit_distance_m",
                   "fit_iterations", "ground_threshold_m", "max_slope_deg", "max_tilt_deg", "max_step_m",
-                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m"})) {
+                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m", "blend_radial"})) {
     return;
   }
   // The lists are checked against each other only when each was read (a bad list has its own issue).
@@ -194,6 +194,7 @@ void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
   r.number(z, path, "max_slope_change_deg", p.max_slope_change_deg, 0.0, 80.0, "degrees");
   r.number(z, path, "min_spread_m", p.min_spread_m, 0.0, 100.0, "m");
   r.number(z, path, "max_extrapolation_m", p.max_extrapolation_m, 0.0, 500.0, "m");
+  if (auto e = r.choice(z, path, "blend_radial", {"false", "true"})) p.blend_radial = *e == 1;
   for (std::size_t i = 1; i < p.edges_m.size(); ++i) {
     if (!(p.edges_m[i] > p.edges_m[i - 1])) {
       r.issue(value_or(z, "edges_m"), path + ".edges_m", "zone edges must increase from the sensor outwards");
@@ -233,11 +234,14 @@ void read_ground(YamlReader& r, const YAML::Node& g, perception::GroundParams& p
 void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams& p) {
   const std::string path = "perception.cluster";
   if (!r.section(c, path,
-                 {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m"})) {
+                 {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m",
+                  "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m"})) {
     return;
   }
-  if (auto m = r.choice(c, path, "method", {"fixed", "adaptive"})) {
-    p.method = *m == 0 ? perception::ClusterMethod::Fixed : perception::ClusterMethod::Adaptive;
+  if (auto m = r.choice(c, path, "method", {"fixed", "adaptive", "anisotropic"})) {
+    p.method = *m == 0   ? perception::ClusterMethod::Fixed
+               : *m == 1 ? perception::ClusterMethod::Adaptive
+                         : perception::ClusterMethod::Anisotropic;
   }
   if (auto s = r.choice(c, path, "structure", {"kdtree", "grid"})) {
     p.structure = *s == 0 ? perception::ClusterStructure::KdTree : perception::ClusterStructure::Grid;
@@ -246,7 +250,22 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   r.number(c, path, "beam_spacing_deg", p.beam_spacing_deg, 0.01, 10.0, "degrees");
   r.number(c, path, "beam_factor", p.beam_factor, 0.0, 10.0, "");
   r.number(c, path, "max_tolerance_m", p.max_tolerance_m, 0.01, 10.0, "m");
-  if (p.method == perception::ClusterMethod::Adaptive) {
+  r.number(c, path, "horizontal_beam_factor", p.horizontal_beam_factor, 0.0, 10.0, "");
+  r.number(c, path, "horizontal_max_tolerance_m", p.horizontal_max_tolerance_m, 0.01, 10.0, "m");
+  r.integer(c, path, "absorb_max_points", p.absorb_max_points, 0, 1000000);
+  r.number(c, path, "absorb_margin_m", p.absorb_margin_m, 0.0, 10.0, "m");
+  if (p.method == perception::ClusterMethod::Anisotropic) {
+    if (p.horizontal_max_tolerance_m < p.tolerance_m) {
+      r.issue(value_or(c, "horizontal_max_tolerance_m"), path + ".horizontal_max_tolerance_m",
+              "must not be less than tolerance_m; the horizontal radius grows from tolerance_m up to it");
+    }
+    if (p.horizontal_beam_factor * std::tan(p.beam_spacing_deg * std::numbers::pi / 180.0) >= 0.5) {
+      r.issue(value_or(c, "horizontal_beam_factor"), path + ".horizontal_beam_factor",
+              "horizontal_beam_factor * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a "
+              "metre per metre of range); lower horizontal_beam_factor");
+    }
+  }
+  if (p.method != perception::ClusterMethod::Fixed) {
     if (p.max_tolerance_m < p.tolerance_m) {
       r.issue(value_or(c, "max_tolerance_m"), path + ".max_tolerance_m",
               "must not be less than tolerance_m; the adaptive radius grows from tolerance_m up to it");
@@ -263,7 +282,8 @@ void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& 
   const std::string fp = "perception.filters";
   if (!r.section(f, fp,
                  {"min_points", "max_points", "min_volume_m3", "max_volume_m3", "min_height_m",
-                  "min_points_full_range_m", "min_points_floor"})) {
+                  "min_points_full_range_m", "min_points_floor", "canopy_max_height_m", "canopy_min_jitter_m",
+                  "canopy_min_triples", "canopy_max_gap_m", "canopy_needle_depth_m", "canopy_needle_ratio"})) {
     return;
   }
   r.integer(f, fp, "min_points", p.min_points, 1, 10000000);
@@ -273,6 +293,12 @@ void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& 
   r.number(f, fp, "min_height_m", p.min_height_m, 0.0, 10.0, "m");
   r.number(f, fp, "min_points_full_range_m", p.min_points_full_range_m, 0.0, 500.0, "m");
   r.integer(f, fp, "min_points_floor", p.min_points_floor, 1, 10000000);
+  r.number(f, fp, "canopy_max_height_m", p.canopy_max_height_m, 0.0, 3.0, "m");
+  r.number(f, fp, "canopy_min_jitter_m", p.canopy_min_jitter_m, 0.01, 2.0, "m");
+  r.integer(f, fp, "canopy_min_triples", p.canopy_min_triples, 1, 100000);
+  r.number(f, fp, "canopy_max_gap_m", p.canopy_max_gap_m, 0.05, 5.0, "m");
+  r.number(f, fp, "canopy_needle_depth_m", p.canopy_needle_depth_m, 0.0, 10.0, "m");
+  r.number(f, fp, "canopy_needle_ratio", p.canopy_needle_ratio, 1.0, 100.0, "");
   if (p.max_points > 0 && p.min_points > p.max_points) {
     r.issue(value_or(f, "max_points"), fp + ".max_points", "must not be less than min_points (0 = no upper limit)");
   }

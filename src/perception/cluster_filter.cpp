@@ -14,6 +14,7 @@ std::string_view to_string(Rejection r) {
     case Rejection::TooSmall: return "box too small";
     case Rejection::TooLarge: return "box too large";
     case Rejection::TooLow: return "too low above the ground";
+    case Rejection::Porous: return "porous (crop canopy)";
   }
   return "?";
 }
@@ -69,6 +70,23 @@ Rejection check_cluster(const FilterParams& f, const ClusterSummary& s) {
   if (f.max_volume_m3 > 0.0 && v > f.max_volume_m3) return Rejection::TooLarge;
   if (f.min_height_m > 0.0 && static_cast<double>(s.height_above_ground_m) < f.min_height_m) return Rejection::TooLow;
   return Rejection::Kept;
+}
+
+Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
+                       std::span<const std::uint32_t> indices, RingJitterMeter& meter) {
+  if (!(f.canopy_max_height_m > 0.0) || static_cast<double>(s.height_above_ground_m) > f.canopy_max_height_m) {
+    return Rejection::Kept;
+  }
+  const RingJitter j = meter.measure(cloud, indices);
+  // Two returns 0.5 m apart along a ray are as likely a person and the ground behind: a needle needs three.
+  constexpr std::uint32_t kNeedleMinPoints = 3;
+  if (f.canopy_needle_depth_m > 0.0 && s.points >= kNeedleMinPoints &&
+      static_cast<double>(j.depth_m) >= f.canopy_needle_depth_m &&
+      static_cast<double>(j.depth_m) >= f.canopy_needle_ratio * static_cast<double>(j.width_m)) {
+    return Rejection::Porous;
+  }
+  if (j.triples < static_cast<std::uint32_t>(std::max(f.canopy_min_triples, 1))) return Rejection::Kept;
+  return static_cast<double>(j.median_m) >= f.canopy_min_jitter_m ? Rejection::Porous : Rejection::Kept;
 }
 
 }  // namespace fieldguard::perception

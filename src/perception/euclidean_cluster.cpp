@@ -36,15 +36,35 @@ EuclideanClusterer::EuclideanClusterer(const ClusterParams& params) : params_(pa
   // handed to FLANN as float.
   const auto t = static_cast<float>(params_.tolerance_m);
   base_r2_ = static_cast<float>(static_cast<double>(t) * static_cast<double>(t));
-  adaptive_ = params_.method == ClusterMethod::Adaptive;
+  anisotropic_ = params_.method == ClusterMethod::Anisotropic;
+  adaptive_ = params_.method == ClusterMethod::Adaptive || anisotropic_;
   if (adaptive_) {
-    const double g = params_.beam_factor * std::tan(params_.beam_spacing_deg * std::numbers::pi / 180.0);
+    const double spacing = std::tan(params_.beam_spacing_deg * std::numbers::pi / 180.0);
+    const double g = params_.beam_factor * spacing;
     if (!(g >= 0.0 && g < 0.5)) {
       throw std::invalid_argument("EuclideanClusterer: beam_factor * tan(beam_spacing_deg) must be in [0, 0.5)");
     }
     growth_ = static_cast<float>(g);
     cap_ = static_cast<float>(std::max(params_.max_tolerance_m, params_.tolerance_m));
+    if (anisotropic_) {
+      const double gh = params_.horizontal_beam_factor * spacing;
+      if (!(gh >= 0.0 && gh < 0.5)) {
+        throw std::invalid_argument(
+            "EuclideanClusterer: horizontal_beam_factor * tan(beam_spacing_deg) must be in [0, 0.5)");
+      }
+      if (!std::isfinite(params_.horizontal_max_tolerance_m)) {
+        throw std::invalid_argument("EuclideanClusterer: horizontal_max_tolerance_m must be finite");
+      }
+      growth_h_ = static_cast<float>(gh);
+      cap_h_ = static_cast<float>(std::max(params_.horizontal_max_tolerance_m, params_.tolerance_m));
+    }
   }
+}
+
+float EuclideanClusterer::horizontal_radius_at(float range_m) const {
+  if (!anisotropic_) return radius_at(range_m);
+  const auto t = static_cast<float>(params_.tolerance_m);
+  return std::min(cap_h_, std::max(t, growth_h_ * range_m));
 }
 
 float EuclideanClusterer::radius_at(float range_m) const {
@@ -77,6 +97,22 @@ void EuclideanClusterer::prepare(const Cloud& in) {
   r2_.resize(n);
   query_.resize(n);
   const auto t = static_cast<float>(params_.tolerance_m);
+  if (anisotropic_) {
+    // Each radius is at most max(t, g * range) capped, with g the larger growth: the same bound holds with g.
+    h2_.resize(n);
+    const float g = std::max(growth_, growth_h_);
+    const float reach = g / (1.F - g);
+    const float cap = std::max(cap_, cap_h_);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float range = std::sqrt(in.x[i] * in.x[i] + in.y[i] * in.y[i] + in.z[i] * in.z[i]);
+      const float v = std::min(cap_, std::max(t, growth_ * range));
+      const float h = std::min(cap_h_, std::max(t, growth_h_ * range));
+      r2_[i] = v == t ? base_r2_ : v * v;
+      h2_[i] = h == t ? base_r2_ : h * h;
+      query_[i] = std::max(std::max(v, h), std::min(cap, reach * range));
+    }
+    return;
+  }
   const float reach = growth_ / (1.F - growth_);
   for (std::size_t i = 0; i < n; ++i) {
     const float range = std::sqrt(in.x[i] * in.x[i] + in.y[i] * in.y[i] + in.z[i] * in.z[i]);
@@ -132,11 +168,25 @@ void EuclideanClusterer::extract_kdtree(const Cloud& in, Clusters& out) {
           done_[pos] = 1U;
           queue_.push_back(pos);
         });
-      } else {
+      } else if (!anisotropic_) {
         const float own = r2_[p.index];
         const float q = query_[p.index];
         tree_.radius_visit(p.x, p.y, p.z, q * q, [&](std::uint32_t pos, float d2) {
           if (done_[pos] != 0U || !(d2 < std::max(own, r2_[pts[pos].index]))) return;
+          done_[pos] = 1U;
+          queue_.push_back(pos);
+        });
+      } else {
+        const float own_v = r2_[p.index], own_h = h2_[p.index];
+        const float q = query_[p.index];
+        tree_.radius_visit(p.x, p.y, p.z, q * q, [&](std::uint32_t pos, float /*d2*/) {
+          if (done_[pos] != 0U) return;
+          const KdTree::Point& o = pts[pos];
+          const float dx = o.x - p.x, dy = o.y - p.y, dz = o.z - p.z;
+          if (!joins_anisotropic(dx * dx + dy * dy, dz * dz, std::max(own_h, h2_[o.index]),
+                                 std::max(own_v, r2_[o.index]))) {
+            return;
+          }
           done_[pos] = 1U;
           queue_.push_back(pos);
         });
@@ -226,33 +276,44 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     col_cells_[c] = static_cast<std::uint32_t>(cells_.size());
     const std::uint32_t b = col_start_[c], e = col_start_[c + 1];
     for (std::uint32_t j = b; j < e; ++j) {
-      if (j == b || gp[j].iz != gp[j - 1].iz) cells_.push_back(Cell{j, static_cast<std::uint32_t>(c), gp[j].iz, 0.F});
+      if (j == b || gp[j].iz != gp[j - 1].iz)
+        cells_.push_back(Cell{j, static_cast<std::uint32_t>(c), gp[j].iz, 0.F, 0.F});
     }
   }
   col_cells_[cols] = static_cast<std::uint32_t>(cells_.size());
   const auto ncells = static_cast<std::uint32_t>(cells_.size());
-  cells_.push_back(Cell{static_cast<std::uint32_t>(n), 0, 0, 0.F});  // sentinel: the end of the last cell
+  cells_.push_back(Cell{static_cast<std::uint32_t>(n), 0, 0, 0.F, 0.F});  // sentinel: the end of the last cell
   sorted_r2_.resize(n);
+  if (anisotropic_) sorted_h2_.resize(n);
   parent_.resize(ncells);
   for (std::uint32_t c = 0; c < ncells; ++c) {
     parent_[c] = c;
-    float m = base_r2_;
+    float m = base_r2_, mh = base_r2_;
     for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) {
       const float r2 = adaptive_ ? r2_[gp[j].index] : base_r2_;
       sorted_r2_[j] = r2;
       m = std::max(m, r2);
+      if (anisotropic_) {
+        sorted_h2_[j] = h2_[gp[j].index];
+        mh = std::max(mh, sorted_h2_[j]);
+      }
     }
+    // Anisotropic: both radii grow with range, so of a joining pair the farther point has the larger of each
+    // and reaches the other within its cell's largest horizontal (hreach2) and vertical (reach2) radius.
     cells_[c].reach2 = m;
+    cells_[c].hreach2 = anisotropic_ ? mh : m;
   }
 
   // Joins. From each cell, the cells within its own reach (its points' search radius): of two points, the
   // one with the larger radius reaches the other, so every joining pair is tested from at least one side.
   std::uint32_t* parent = parent_.data();
   const float* r2 = sorted_r2_.data();
+  const float* h2 = anisotropic_ ? sorted_h2_.data() : nullptr;
+  const bool aniso = anisotropic_;
   // The gap between two cells `d` apart on an axis (a whole cell less, taken short by kSlack), for every
   // offset a cell's reach covers: looked up per neighbour instead of computed.
   float max_reach2 = 0.F;
-  for (std::uint32_t c = 0; c < ncells; ++c) max_reach2 = std::max(max_reach2, cells_[c].reach2);
+  for (std::uint32_t c = 0; c < ncells; ++c) max_reach2 = std::max({max_reach2, cells_[c].reach2, cells_[c].hreach2});
   const auto max_reach = static_cast<std::int64_t>(std::sqrt(max_reach2) / edge) + 1;
   gaps_.resize(static_cast<std::size_t>(2 * max_reach + 1));
   for (std::int64_t d = -max_reach; d <= max_reach; ++d) {
@@ -263,22 +324,23 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   for (std::uint32_t a = 0; a < ncells; ++a) {
     const Cell& ca = cells_[a];
     const std::uint32_t a0 = ca.first, a1 = cells_[a + 1].first;
-    const float reach2 = ca.reach2;
+    const float reach2 = ca.reach2, hreach2 = ca.hreach2;  // equal unless anisotropic
     const auto reach = static_cast<std::int64_t>(std::sqrt(reach2) / edge) + 1;
+    const auto hreach = static_cast<std::int64_t>(std::sqrt(hreach2) / edge) + 1;
     const auto ax = static_cast<std::int64_t>(ca.col / ny), ay = static_cast<std::int64_t>(ca.col % ny);
     const auto az = static_cast<std::int64_t>(ca.iz);
     std::uint32_t ra = find_root(parent, a);  // kept up to date: only this loop joins a's root to another
-    for (std::int64_t x = std::max<std::int64_t>(0, ax - reach);
-         x <= std::min<std::int64_t>(ax + reach, static_cast<std::int64_t>(nx) - 1); ++x) {
+    for (std::int64_t x = std::max<std::int64_t>(0, ax - hreach);
+         x <= std::min<std::int64_t>(ax + hreach, static_cast<std::int64_t>(nx) - 1); ++x) {
       const float gx = gap_at[x - ax];
-      for (std::int64_t y = std::max<std::int64_t>(0, ay - reach);
-           y <= std::min<std::int64_t>(ay + reach, static_cast<std::int64_t>(ny) - 1); ++y) {
+      for (std::int64_t y = std::max<std::int64_t>(0, ay - hreach);
+           y <= std::min<std::int64_t>(ay + hreach, static_cast<std::int64_t>(ny) - 1); ++y) {
         const auto col = static_cast<std::size_t>(x) * ny + static_cast<std::size_t>(y);
         const std::uint32_t first = col_cells_[col], last = col_cells_[col + 1];
         if (first == last) continue;  // an empty column (most are)
         const float gy = gap_at[y - ay];
         const float gxy = gx * gx + gy * gy;
-        if (!(gxy < reach2)) continue;
+        if (!(gxy < hreach2)) continue;
         for (std::uint32_t b = first; b < last; ++b) {
           const Cell& cb = cells_[b];
           if (b == a) continue;
@@ -286,7 +348,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
           if (dz > reach) break;  // cells of a column ascend in z
           if (dz < -reach) continue;
           const float gz = gap_at[dz];
-          if (!(gxy + gz * gz < reach2)) continue;
+          if (aniso ? !joins_anisotropic(gxy, gz * gz, hreach2, reach2) : !(gxy + gz * gz < reach2)) continue;
           const std::uint32_t rb = find_root(parent, b);
           if (ra == rb) continue;
           const std::uint32_t b0 = cb.first, b1 = cells_[b + 1].first;
@@ -295,8 +357,9 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
             const GridPoint p = gp[i];
             for (std::uint32_t j = b0; j < b1; ++j) {
               const float dx = gp[j].x - p.x, dy = gp[j].y - p.y, dz2 = gp[j].z - p.z;
-              const float d2 = dx * dx + dy * dy + dz2 * dz2;
-              if (d2 < std::max(r2[i], r2[j])) {
+              const float dxy2 = dx * dx + dy * dy;
+              if (aniso ? joins_anisotropic(dxy2, dz2 * dz2, std::max(h2[i], h2[j]), std::max(r2[i], r2[j]))
+                        : dxy2 + dz2 * dz2 < std::max(r2[i], r2[j])) {
                 joined = true;
                 break;
               }

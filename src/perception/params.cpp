@@ -14,12 +14,14 @@ PipelineParams published_params() {
   p.cluster.method = ClusterMethod::Fixed;
   p.cluster.structure = ClusterStructure::KdTree;
   p.cluster.tolerance_m = 0.6;
+  p.cluster.absorb_max_points = 0;
   p.filters.min_points = 10;
   p.filters.max_points = 240;
   p.filters.min_volume_m3 = 0.06;
   p.filters.max_volume_m3 = 1.2;
   p.filters.min_height_m = 0.0;
   p.filters.min_points_full_range_m = 0.0;
+  p.filters.canopy_max_height_m = 0.0;
   // The published method had no 2D LiDAR: 2D points of a merged frame are left out of it entirely.
   p.near_field.enabled = false;
   return p;

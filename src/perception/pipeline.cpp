@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "fieldguard/perception/cluster_absorb.hpp"
 #include "fieldguard/perception/cluster_filter.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
@@ -19,7 +20,13 @@
 namespace fieldguard::perception {
 
 struct Pipeline::Impl {
-  explicit Impl(const PipelineParams& p) : params(p), voxel(p.voxel), clusterer(p.cluster), near(p.near_field) {
+  explicit Impl(const PipelineParams& p)
+      : params(p),
+        voxel(p.voxel),
+        clusterer(p.cluster),
+        absorber(p.cluster.absorb_max_points, p.cluster.absorb_margin_m),
+        near(p.near_field),
+        jitter(p.cluster.beam_spacing_deg, p.filters.canopy_max_gap_m) {
     if (p.roi.min[0] >= p.roi.max[0] || p.roi.min[1] >= p.roi.max[1] || p.roi.min[2] >= p.roi.max[2]) {
       throw std::invalid_argument("Pipeline: the ROI box needs min < max on every axis");
     }
@@ -35,7 +42,9 @@ struct Pipeline::Impl {
   std::optional<RansacGround> ransac;
   std::optional<ZoneGround> zones;
   EuclideanClusterer clusterer;
+  ClusterAbsorber absorber;
   NearField near;
+  RingJitterMeter jitter;
 
   Cloud cropped, voxels, above;
   GroundLabels ground;
@@ -104,6 +113,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   result.counts.ground = ground_count;
 
   m.clusterer.extract(m.above, m.clusters);
+  m.absorber.absorb(m.above, m.clusters);
 
   const FilterParams& f = m.params.filters;
   for (std::size_t c = 0; c < m.clusters.size(); ++c) {
@@ -126,6 +136,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
       limit_height_to_extent(s, floor_z);
       why = check_cluster(f, s);
     }
+    if (why == Rejection::Kept) why = check_canopy(f, s, m.above, members, m.jitter);
     // Too few points for its distance: not a cluster at all (PCL's minimum cluster size), left unclustered.
     if (why == Rejection::TooFewPoints) continue;
     ++result.counts.clusters;

@@ -257,6 +257,24 @@ void ZoneGround::interpolate_gaps() {
   for (std::size_t b = 0; b < bins_.size(); ++b) bins_[b].plane = filled_[b];
 }
 
+// The ground under (x, y) in `bin`: between where its plane was fitted and where the plane of the bin beyond
+// it on the point's side (outside it when the point lies farther out than that, else inside) was fitted, the
+// two planes interpolated by distance, as a ring's measured ground gives way to the next ring's. A neighbour
+// without a plane of its own does not count (its plane is a blend already).
+float ZoneGround::blended_z(std::uint32_t bin, float x, float y) const {
+  const Bin& own = bins_[bin];
+  const float z_own = own.plane.z_at(x, y);
+  const float r2 = x * x + y * y, ref_r2 = own.ref_x * own.ref_x + own.ref_y * own.ref_y;
+  const std::uint32_t nb = r2 >= ref_r2 ? outer_[bin] : inner_[bin];
+  if (nb == kNoBin || !bins_[nb].fitted) return z_own;
+  const Bin& other = bins_[nb];
+  const float d_own = std::hypot(x - own.ref_x, y - own.ref_y);
+  const float d_other = std::hypot(x - other.ref_x, y - other.ref_y);
+  const float sum = d_own + d_other;
+  if (!(sum > 0.F)) return z_own;
+  return (d_other * z_own + d_own * other.plane.z_at(x, y)) / sum;
+}
+
 void ZoneGround::segment(const Cloud& in, GroundLabels& out) {
   const std::size_t n = in.size();
   const std::size_t nbins = bins_.size();
@@ -311,9 +329,11 @@ void ZoneGround::segment(const Cloud& in, GroundLabels& out) {
 
   const auto threshold = static_cast<float>(params_.ground_threshold_m);
   const auto guess = static_cast<float>(params_.max_extrapolation_m);
+  const bool blend = params_.blend_radial;
   for (std::size_t i = 0; i < n; ++i) {
     const Bin& bin = bins_[bin_of_point_[i]];
-    const float h = in.z[i] - bin.plane.z_at(in.x[i], in.y[i]);
+    const float g = blend ? blended_z(bin_of_point_[i], in.x[i], in.y[i]) : bin.plane.z_at(in.x[i], in.y[i]);
+    const float h = in.z[i] - g;
     out.height_m[i] = h;
     out.ground[i] = h < threshold ? 1U : 0U;
     out.guessed[i] = bin.support_m > guess ? 1U : 0U;

@@ -52,12 +52,14 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.cluster.structure, perception::ClusterStructure::KdTree);
   EXPECT_DOUBLE_EQ(p.filters.min_height_m, 0.0);
   EXPECT_DOUBLE_EQ(p.filters.min_points_full_range_m, 0.0);
+  EXPECT_EQ(p.cluster.absorb_max_points, 0);
   EXPECT_FALSE(p.near_field.enabled);  // the published method had no 2D LiDAR
   // And it is what the perception module calls the published method.
   const auto pub = perception::published_params();
   EXPECT_EQ(p.ground.method, pub.ground.method);
   EXPECT_EQ(p.ground.ransac.iterations, pub.ground.ransac.iterations);
   EXPECT_EQ(p.cluster.method, pub.cluster.method);
+  EXPECT_EQ(p.cluster.absorb_max_points, pub.cluster.absorb_max_points);
   EXPECT_EQ(p.filters.max_points, pub.filters.max_points);
   EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, pub.filters.min_volume_m3);
   EXPECT_EQ(p.near_field.enabled, pub.near_field.enabled);
@@ -68,7 +70,7 @@ TEST(ConfigFiles, FieldguardUsesTheFieldMethods) {
   ASSERT_TRUE(r.ok()) << dump(r);
   const auto& p = r.config.perception;
   EXPECT_EQ(p.ground.method, perception::GroundMethod::Zones);
-  EXPECT_EQ(p.cluster.method, perception::ClusterMethod::Adaptive);
+  EXPECT_EQ(p.cluster.method, perception::ClusterMethod::Anisotropic);
   EXPECT_EQ(p.cluster.structure, perception::ClusterStructure::Grid);
   EXPECT_GT(p.filters.min_height_m, 0.0);
   EXPECT_DOUBLE_EQ(p.ground.zones.sensor_height_m, r.config.lidar.mounting.z_m);
@@ -116,6 +118,10 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.cluster.beam_spacing_deg, d.cluster.beam_spacing_deg);
   EXPECT_EQ(p.cluster.beam_factor, d.cluster.beam_factor);
   EXPECT_EQ(p.cluster.max_tolerance_m, d.cluster.max_tolerance_m);
+  EXPECT_EQ(p.cluster.horizontal_beam_factor, d.cluster.horizontal_beam_factor);
+  EXPECT_EQ(p.cluster.horizontal_max_tolerance_m, d.cluster.horizontal_max_tolerance_m);
+  EXPECT_EQ(p.cluster.absorb_max_points, d.cluster.absorb_max_points);
+  EXPECT_EQ(p.cluster.absorb_margin_m, d.cluster.absorb_margin_m);
   EXPECT_EQ(p.filters.min_points, d.filters.min_points);
   EXPECT_EQ(p.filters.max_points, d.filters.max_points);
   EXPECT_EQ(p.filters.min_volume_m3, d.filters.min_volume_m3);
@@ -413,6 +419,47 @@ TEST(ConfigLoad, CalibrationFileRelativeToTheConfigAndCheckedAgainstTheModel) {
   const auto bad = load_config_file((dir / "mismatch.yaml").string());
   EXPECT_TRUE(has_issue(bad, "lidar.calibration_file", "HDL-32E calibration but lidar.model is VLP-16")) << dump(bad);
   fs::remove_all(dir);
+}
+
+// The anisotropic clustering's keys and the small-cluster absorption (cluster_absorb.hpp).
+TEST(ConfigLoad, ReadsTheAnisotropicClusterKeys) {
+  const auto r = load_config_text(R"(
+perception:
+  cluster: {method: anisotropic, tolerance_m: 0.3, beam_factor: 3.0, max_tolerance_m: 2.5,
+            horizontal_beam_factor: 1.2, horizontal_max_tolerance_m: 0.9, absorb_max_points: 7, absorb_margin_m: 0.2}
+)",
+                                  "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& c = r.config.perception.cluster;
+  EXPECT_EQ(c.method, perception::ClusterMethod::Anisotropic);
+  EXPECT_DOUBLE_EQ(c.beam_factor, 3.0);
+  EXPECT_DOUBLE_EQ(c.max_tolerance_m, 2.5);
+  EXPECT_DOUBLE_EQ(c.horizontal_beam_factor, 1.2);
+  EXPECT_DOUBLE_EQ(c.horizontal_max_tolerance_m, 0.9);
+  EXPECT_EQ(c.absorb_max_points, 7);
+  EXPECT_DOUBLE_EQ(c.absorb_margin_m, 0.2);
+}
+
+TEST(ConfigLoad, ReportsBadAnisotropicClusterKeys) {
+  const std::string text =
+      "perception:\n"                          // 1
+      "  cluster:\n"                           // 2
+      "    method: anisotropic\n"              // 3
+      "    tolerance_m: 0.8\n"                 // 4
+      "    beam_spacing_deg: 5\n"              // 5
+      "    horizontal_max_tolerance_m: 0.5\n"  // 6 below tolerance_m
+      "    horizontal_beam_factor: 9\n"        // 7 9 * tan(5 deg): grows too fast
+      "    absorb_max_points: -1\n"            // 8 out of range
+      "    absorb_margin_m: 20\n"              // 9 out of range
+      "    absorb_points: 3\n";                // 10 unknown key
+  const auto r = load_config_text(text, "bad.yaml");
+  EXPECT_TRUE(has_issue(r, "perception.cluster.horizontal_max_tolerance_m", "must not be less than tolerance_m", 6))
+      << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.horizontal_beam_factor", "below 0.5", 7)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_max_points", "out of range", 8)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_margin_m", "out of range", 9)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_points", "unknown key", 10)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 5U) << dump(r);
 }
 
 }  // namespace

@@ -27,12 +27,27 @@ ClusterSets sets_of(const Clusters& c) {
   return s;
 }
 
+// The adaptive radius these tests were written for (1.3 ring gaps, capped at 1.2 m), whatever the defaults are;
+// anisotropic: the defaults of config/fieldguard.yaml's first anisotropic setting.
 ClusterParams params(ClusterMethod m, ClusterStructure s, double tolerance = 0.6) {
   ClusterParams p;
   p.method = m;
   p.structure = s;
   p.tolerance_m = tolerance;
+  if (m == ClusterMethod::Anisotropic) {
+    p.beam_factor = 4.0;
+    p.max_tolerance_m = 3.0;
+    p.horizontal_beam_factor = 1.7;
+    p.horizontal_max_tolerance_m = 1.5;
+  } else {
+    p.beam_factor = 1.3;
+    p.max_tolerance_m = 1.2;
+  }
   return p;
+}
+
+const char* method_name(ClusterMethod m) {
+  return m == ClusterMethod::Fixed ? "Fixed" : m == ClusterMethod::Adaptive ? "Adaptive" : "Anisotropic";
 }
 
 // Two solid boxes (0.1 m lattice) whose facing sides are `gap` apart, 5 m ahead.
@@ -95,10 +110,11 @@ TEST_P(EveryClusterer, OutputOrder) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, EveryClusterer,
-                         ::testing::Combine(::testing::Values(ClusterMethod::Fixed, ClusterMethod::Adaptive),
+                         ::testing::Combine(::testing::Values(ClusterMethod::Fixed, ClusterMethod::Adaptive,
+                                                              ClusterMethod::Anisotropic),
                                             ::testing::Values(ClusterStructure::KdTree, ClusterStructure::Grid)),
                          [](const ::testing::TestParamInfo<std::tuple<ClusterMethod, ClusterStructure>>& p) {
-                           return std::string(std::get<0>(p.param) == ClusterMethod::Fixed ? "Fixed" : "Adaptive") +
+                           return std::string(method_name(std::get<0>(p.param))) +
                                   (std::get<1>(p.param) == ClusterStructure::KdTree ? "KdTree" : "Grid");
                          });
 
@@ -250,7 +266,7 @@ TEST(EuclideanClusterer, PairsJustInsideAndOutsideTheRadius) {
 // A shed's walls after the voxel grid: two dense 0.15 m lattices (4 m long, 3 m high) whose facing sides are
 // 0.55 m apart are one cluster, 0.65 m apart two; the grid agrees with the k-d tree point for point.
 TEST(EuclideanClusterer, DenseWallsJoinOrStayApart) {
-  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive}) {
+  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
     for (const float gap : {0.55F, 0.65F}) {
       Cloud c;
       testing::add_block(c, {6.0F, -2.0F, -1.0F}, {2, 27, 20}, 0.15F);         // x 6.00 .. 6.15
@@ -288,6 +304,150 @@ TEST(EuclideanClusterer, RefusesImpossibleRadii) {
   ClusterParams p = params(ClusterMethod::Adaptive, ClusterStructure::Grid);
   p.beam_factor = 40.0;  // 0.93 m per metre
   EXPECT_THROW(EuclideanClusterer{p}, std::invalid_argument);
+  ClusterParams a = params(ClusterMethod::Anisotropic, ClusterStructure::Grid);
+  a.horizontal_beam_factor = 40.0;
+  EXPECT_THROW(EuclideanClusterer{a}, std::invalid_argument);
+  a = params(ClusterMethod::Anisotropic, ClusterStructure::Grid);
+  a.beam_factor = 40.0;
+  EXPECT_THROW(EuclideanClusterer{a}, std::invalid_argument);
+  a = params(ClusterMethod::Anisotropic, ClusterStructure::Grid);
+  a.horizontal_max_tolerance_m = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(EuclideanClusterer{a}, std::invalid_argument);
+}
+
+// --- Anisotropic: a horizontal and a vertical radius.
+
+constexpr float kDeg = std::numbers::pi_v<float> / 180.F;
+
+// One scan ring's returns on a porous crown at `range` (m) of ring elevation `elev_deg`: points every 0.15 m
+// (the voxel grid) across `width` m centred on bearing `bearing_deg`, each at a depth inside the crown that
+// steps through `depths` (m), as the exponential stopping depth scatters them.
+void add_ring_slice(Cloud& c, float range, float bearing_deg, float elev_deg, float width,
+                    std::initializer_list<float> depths) {
+  const int n = static_cast<int>(width / 0.15F) + 1;
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    const float d = range + depths.begin()[static_cast<std::size_t>(k++) % depths.size()];
+    const float b = bearing_deg * kDeg + (static_cast<float>(i) * 0.15F - 0.5F * width) / range;
+    const float r = d * std::cos(elev_deg * kDeg);
+    c.push_back(r * std::cos(b), r * std::sin(b), d * std::sin(elev_deg * kDeg));
+  }
+}
+
+// The same clusters from both structures, over ranges where both radii vary and hit their caps.
+TEST(EuclideanClusterer, AnisotropicKdTreeAndGridAgree) {
+  testing::TestRng rng{21};
+  Cloud c;
+  for (int i = 0; i < 5000; ++i) c.push_back(rng.uniform(-10, 50), rng.uniform(-10, 10), rng.uniform(-1.5F, 4.F));
+  for (int i = 0; i < 1500; ++i) c.push_back(rng.uniform(5, 9), rng.uniform(-2, 2), rng.uniform(-1.F, 3.F));
+  Clusters a, b;
+  EuclideanClusterer kd(params(ClusterMethod::Anisotropic, ClusterStructure::KdTree, 0.4));
+  EuclideanClusterer grid(params(ClusterMethod::Anisotropic, ClusterStructure::Grid, 0.4));
+  kd.extract(c, a);
+  grid.extract(c, b);
+  EXPECT_GT(a.size(), 50U);
+  EXPECT_EQ(sets_of(a), sets_of(b));
+}
+
+TEST(EuclideanClusterer, AnisotropicRadii) {
+  const EuclideanClusterer e(params(ClusterMethod::Anisotropic, ClusterStructure::Grid, 0.4));
+  const float gap = std::tan(1.33F * kDeg);
+  EXPECT_FLOAT_EQ(e.radius_at(2.F), 0.4F);  // both floored at tolerance_m near the sensor
+  EXPECT_FLOAT_EQ(e.horizontal_radius_at(2.F), 0.4F);
+  EXPECT_NEAR(e.radius_at(20.F), 4.F * 20.F * gap, 1e-4F);
+  EXPECT_NEAR(e.horizontal_radius_at(20.F), 1.7F * 20.F * gap, 1e-4F);
+  EXPECT_FLOAT_EQ(e.radius_at(500.F), 3.F);  // capped
+  EXPECT_FLOAT_EQ(e.horizontal_radius_at(500.F), 1.5F);
+  const EuclideanClusterer f(params(ClusterMethod::Adaptive, ClusterStructure::Grid));
+  EXPECT_FLOAT_EQ(f.horizontal_radius_at(30.F), f.radius_at(30.F));  // one radius when not anisotropic
+}
+
+// Two crowns side by side at 8 m whose nearest returns are 0.45 m apart, each four rings of porous returns: the
+// adaptive radius (0.6 m there) joins them, the anisotropic one (0.4 m horizontally) keeps them two, each one
+// cluster. (Nearer than 0.4 m they would join: the horizontal radius is the floor of what stays apart.)
+TEST(EuclideanClusterer, AnisotropicKeepsCrownsSideBySideTwo) {
+  Cloud c;
+  for (const float elev : {-2.67F, -1.33F, 0.F, 1.33F}) {
+    // Tangential offsets at 8 m: the first slice's returns from -0.8 to 0.7 m, the second's from 1.15 m.
+    add_ring_slice(c, 8.F, 0.F, elev, 1.6F, {0.F, 0.1F, 0.05F});
+    add_ring_slice(c, 8.F, (0.7F + 0.45F + 0.8F) / 8.F / kDeg, elev, 1.6F, {0.F, 0.1F, 0.05F});
+  }
+  const std::size_t half = c.size() / 2;
+  for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+    Clusters out;
+    EuclideanClusterer adaptive(params(ClusterMethod::Adaptive, structure));
+    adaptive.extract(c, out);
+    EXPECT_EQ(out.size(), 1U);
+    EuclideanClusterer aniso(params(ClusterMethod::Anisotropic, structure, 0.4));
+    aniso.extract(c, out);
+    ASSERT_EQ(out.size(), 2U);
+    EXPECT_EQ(out[0].size(), half);
+    EXPECT_EQ(out[1].size(), half);
+  }
+}
+
+// A porous crown at 25 m: three rings 0.58 m apart (25 m * tan(1.33 deg)) whose returns stopped at depths that
+// differ by 0.6 m and more from ring to ring. The adaptive radius (0.76 m there) leaves three ring slices; the
+// anisotropic one (2.3 m vertically, 1.0 m horizontally) one crown.
+TEST(EuclideanClusterer, AnisotropicJoinsAPorousCrownsRingSlices) {
+  Cloud c;
+  add_ring_slice(c, 25.F, 10.F, -1.33F, 2.F, {0.F, 0.05F});
+  add_ring_slice(c, 25.F, 10.F, 0.F, 2.F, {0.65F, 0.7F});
+  add_ring_slice(c, 25.F, 10.F, 1.33F, 2.F, {1.3F, 1.35F});
+  for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+    Clusters out;
+    EuclideanClusterer adaptive(params(ClusterMethod::Adaptive, structure));
+    adaptive.extract(c, out);
+    EXPECT_EQ(out.size(), 3U);
+    EuclideanClusterer aniso(params(ClusterMethod::Anisotropic, structure, 0.4));
+    aniso.extract(c, out);
+    EXPECT_EQ(out.size(), 1U);
+  }
+}
+
+// A person side-on at 30 m: three rings 0.70 m apart, two or three returns each, the legs' ring 0.25 m off the
+// torso's horizontally (a stride). One cluster; and a second person 1.5 m beside them stays apart (the
+// horizontal radius there is 1.19 m).
+TEST(EuclideanClusterer, AnisotropicKeepsAFarPersonOneCluster) {
+  Cloud c;
+  const float ring = 30.F * std::tan(1.33F * kDeg);
+  for (const float y0 : {0.F, 0.16F + 1.5F}) {
+    c.push_back(30.25F, y0 + 0.00F, -ring);  // legs
+    c.push_back(30.25F, y0 + 0.08F, -ring);
+    c.push_back(30.00F, y0 + 0.00F, 0.F);  // torso
+    c.push_back(30.00F, y0 + 0.08F, 0.F);
+    c.push_back(30.00F, y0 + 0.16F, 0.F);
+    c.push_back(30.05F, y0 + 0.04F, ring);  // head and shoulders
+    c.push_back(30.05F, y0 + 0.12F, ring);
+  }
+  for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+    Clusters out;
+    EuclideanClusterer aniso(params(ClusterMethod::Anisotropic, structure, 0.4));
+    aniso.extract(c, out);
+    ASSERT_EQ(out.size(), 2U);
+    EXPECT_EQ(out[0].size(), 7U);
+    EXPECT_EQ(out[1].size(), 7U);
+  }
+}
+
+// Just inside and just outside the ellipse at 5 m: the vertical radius is 4 * 5 * tan(1.33 deg) = 0.465 m, the
+// horizontal one 0.4 m (its floor). (0.30, 0.27) is 0.404 m away: outside a 0.4 m sphere, inside the ellipse.
+TEST(EuclideanClusterer, AnisotropicEllipseBoundary) {
+  const EuclideanClusterer probe(params(ClusterMethod::Anisotropic, ClusterStructure::Grid, 0.4));
+  for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+    EuclideanClusterer e(params(ClusterMethod::Anisotropic, structure, 0.4));
+    // (dz, dy): straight up, straight aside, and diagonally; margins of a few percent around the boundary.
+    for (const auto& [dz, dy, joined] :
+         {std::tuple{0.44F, 0.F, true}, std::tuple{0.52F, 0.F, false}, std::tuple{0.F, 0.38F, true},
+          std::tuple{0.F, 0.42F, false}, std::tuple{0.3F, 0.27F, true}, std::tuple{0.36F, 0.32F, false}}) {
+      Cloud c;
+      c.push_back(5.F, 0.F, 0.F);
+      c.push_back(5.F, dy, dz);
+      Clusters out;
+      e.extract(c, out);
+      EXPECT_EQ(out.size(), joined ? 1U : 2U) << dz << " " << dy << " V " << probe.radius_at(5.F);
+    }
+  }
 }
 
 }  // namespace

@@ -151,6 +151,53 @@ TEST(ZoneGround, FarPersonWithNoGroundAroundIsNotGround) {
   EXPECT_NEAR(zones.ground_z(30.F, 0.5F), -0.95F, 0.1F);
 }
 
+// Ground flat to 18 m, then climbing at 8 %: the bin from 10 to 20 m is fitted to the flat part and carries it to
+// its outer edge, the bin from 20 to 30 m to the climb. A clod 0.4 m high at 19.8 m stands 0.54 m above the
+// inner bin's plane (an obstacle to min_height_m 0.5); blending in the plane of the bin beyond, by distance to
+// where each was fitted, brings it back to about its true height. At the inner bin's own fitted points
+// nothing changes.
+TEST(ZoneGround, BlendsThePlaneBeyondAtABinsOuterEdge) {
+  const auto ground = [](float r) { return -0.95F + 0.08F * std::max(0.F, r - 18.F); };
+  Cloud c;
+  for (float r = 2.5F; r < 10.F; r += 0.25F) {  // the innermost zone all round: the vehicle's own plane
+    for (float deg = -180.F; deg < 180.F; deg += 2.F) {
+      const float a = deg * static_cast<float>(kPi) / 180.F;
+      c.push_back(r * std::cos(a), r * std::sin(a), ground(r));
+    }
+  }
+  for (float r = 10.F; r < 30.F; r += 0.25F) {  // farther out, one sector's worth around 22.5 degrees
+    if (r > 18.F && r < 20.5F) continue;        // the rings skip the bend
+    for (float deg = 5.F; deg < 40.F; deg += 1.F) {
+      const float a = deg * static_cast<float>(kPi) / 180.F;
+      c.push_back(r * std::cos(a), r * std::sin(a), ground(r));
+    }
+  }
+  const float a = 22.5F * static_cast<float>(kPi) / 180.F;
+  const auto probe = static_cast<std::uint32_t>(c.size());
+  c.push_back(19.8F * std::cos(a), 19.8F * std::sin(a), ground(19.8F) + 0.4F);  // the clod's top
+  const auto on_fit = static_cast<std::uint32_t>(c.size());
+  c.push_back(14.F * std::cos(a), 14.F * std::sin(a), ground(14.F));
+
+  ZoneParams zp;
+  zp.edges_m = {2.0, 10.0, 20.0, 30.0};
+  zp.rings = {1, 1, 1};
+  zp.sectors = {8, 8, 8};
+  zp.blend_radial = false;
+  GroundLabels plain, blended;
+  ZoneGround(zp).segment(c, plain);
+  zp.blend_radial = true;
+  ZoneGround zones(zp);
+  zones.segment(c, blended);
+  ASSERT_TRUE(zones.fitted_at(14.F * std::cos(a), 14.F * std::sin(a)));
+  ASSERT_TRUE(zones.fitted_at(25.F * std::cos(a), 25.F * std::sin(a)));
+  EXPECT_NEAR(plain.height_m[probe], 0.4F + 0.08F * 1.8F, 0.03F);  // above the flat plane carried out
+  // The flat plane (fitted about 14 m out) and the climb's (about 25 m out) at 19.8 m, each weighted by the
+  // distance to the other's fit: the clod's true 0.4 m, within what the climb's slope prior leaves.
+  EXPECT_NEAR(blended.height_m[probe], 0.4F, 0.06F);
+  EXPECT_LT(blended.height_m[probe], 0.5F);
+  EXPECT_NEAR(blended.height_m[on_fit], plain.height_m[on_fit], 0.01F);
+}
+
 TEST(ZoneGround, EmptyInputAndTheSurfaceBeforeAnyFrame) {
   ZoneParams p;
   p.sensor_height_m = 1.2;

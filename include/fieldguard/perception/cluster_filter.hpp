@@ -7,6 +7,7 @@
 #include <span>
 #include <string_view>
 
+#include "fieldguard/perception/canopy.hpp"
 #include "fieldguard/perception/cloud.hpp"
 #include "fieldguard/perception/params.hpp"
 
@@ -22,7 +23,7 @@ struct ClusterSummary {
   [[nodiscard]] float volume_m3() const { return (max[0] - min[0]) * (max[1] - min[1]) * (max[2] - min[2]); }
 };
 
-enum class Rejection : std::uint8_t { Kept = 0, TooFewPoints, TooManyPoints, TooSmall, TooLarge, TooLow };
+enum class Rejection : std::uint8_t { Kept = 0, TooFewPoints, TooManyPoints, TooSmall, TooLarge, TooLow, Porous };
 [[nodiscard]] std::string_view to_string(Rejection r);
 
 // `height_m`: every cloud point's height above its local ground; `guessed`: 1 where that ground is a guess
@@ -42,5 +43,11 @@ void limit_height_to_extent(ClusterSummary& s, float floor_z);
 
 // Bounds are inclusive: a cluster of exactly min_points points, or exactly min_volume_m3, is kept.
 [[nodiscard]] Rejection check_cluster(const FilterParams& f, const ClusterSummary& s);
+
+// A second look at a cluster check_cluster kept, in its cloud (`indices` its points): Porous when it is no
+// higher than canopy_max_height_m and its ring jitter (canopy.hpp) says canopy; else Kept.
+[[nodiscard]] Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
+                                     std::span<const std::uint32_t> indices, RingJitterMeter& meter);
+
 
 }  // namespace fieldguard::perception

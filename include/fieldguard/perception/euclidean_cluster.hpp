@@ -5,8 +5,10 @@
 //
 // Fixed: one radius (d^2 < r^2 in float, as pcl::search::KdTree). Adaptive: each point has its radius from its
 // 3D range (ClusterParams); two points join when nearer than the larger of their two radii, which is
-// symmetric, so the clusters do not depend on the search order. Structures: KdTree (our k-d tree, the
-// published way) or Grid (cubic cells small enough that a cell's points always join; union-find over cells,
+// symmetric, so the clusters do not depend on the search order. Anisotropic: each point has a horizontal and a
+// vertical radius, both growing with range; two points join inside the ellipsoid (dxy / H)^2 + (dz / V)^2 < 1
+// with H and V the larger of their horizontal and vertical radii (again symmetric). Structures: KdTree (our k-d
+// tree, the published way) or Grid (cubic cells small enough that a cell's points always join; union-find over cells,
 // neighbouring cells joined by their first pair within reach). Both find exactly the same clusters.
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
@@ -40,6 +42,8 @@ class EuclideanClusterer {
 
   // The clustering radius of a point at 3D range `range_m` (the fixed radius when not adaptive).
   [[nodiscard]] float radius_at(float range_m) const;
+  // Anisotropic: the horizontal radius at 3D range `range_m` (radius_at is the vertical one); else radius_at.
+  [[nodiscard]] float horizontal_radius_at(float range_m) const;
   [[nodiscard]] const ClusterParams& params() const { return params_; }
 
  private:
@@ -47,16 +51,23 @@ class EuclideanClusterer {
   void extract_kdtree(const Cloud& in, Clusters& out);
   void extract_grid(const Cloud& in, Clusters& out);
   void finish_cluster(Clusters& out);
+  // Inside the ellipsoid of horizontal radius sqrt(h2), vertical sqrt(v2): dxy2 / h2 + dz2 / v2 < 1, without
+  // dividing.
+  static bool joins_anisotropic(float dxy2, float dz2, float h2, float v2) { return dxy2 * v2 + dz2 * h2 < h2 * v2; }
 
   ClusterParams params_;
-  float base_r2_ = 0.F;  // fixed radius squared, as PCL rounds it
-  float growth_ = 0.F;   // adaptive: radius per metre of range
-  float cap_ = 0.F;      // adaptive radius cap
-  bool adaptive_ = false;
+  float base_r2_ = 0.F;    // fixed radius squared, as PCL rounds it
+  float growth_ = 0.F;     // adaptive: radius per metre of range
+  float cap_ = 0.F;        // adaptive radius cap
+  bool adaptive_ = false;  // Adaptive or Anisotropic: r2_ holds each point's (vertical) radius
+  bool anisotropic_ = false;
+  float growth_h_ = 0.F;  // anisotropic: horizontal radius per metre of range
+  float cap_h_ = 0.F;     // anisotropic: horizontal radius cap
 
   KdTree tree_;
   // Scratch, reused across frames.
   Buffer<float> r2_;     // per point (adaptive): its radius squared
+  Buffer<float> h2_;     // per point (anisotropic): its horizontal radius squared
   Buffer<float> query_;  // per point: the search radius that finds every neighbour
   Buffer<std::uint8_t> done_;
   Buffer<std::uint32_t> queue_;
@@ -72,12 +83,14 @@ class EuclideanClusterer {
     std::uint32_t first;  // its points: grid_points_[first, next cell's first)
     std::uint32_t col;    // x-y column
     std::uint32_t iz;     // z cell
-    float reach2;         // the largest radius of its points, squared
+    float reach2;         // the largest radius of its points, squared (anisotropic: the vertical one)
+    float hreach2;        // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
   };
   static constexpr std::uint32_t kNoCluster = 0xFFFFFFFFU;
   Buffer<GridPoint> grid_points_;
   Buffer<GridPoint> by_z_;          // the points sorted by z cell (the first radix pass)
   Buffer<float> sorted_r2_;         // r2_ in grid order
+  Buffer<float> sorted_h2_;         // h2_ in grid order (anisotropic)
   Buffer<std::uint32_t> col_next_;  // scratch: per column, then per cluster
   Buffer<Cell> cells_;
   Buffer<std::uint32_t> col_cells_;  // per column: its first cell (cells of a column ascend in z)

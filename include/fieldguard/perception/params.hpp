@@ -62,6 +62,12 @@ struct ZoneParams {
   // Ground farther than this from any bin fitted to its own points is a guess (no ring reached it): a cluster
   // standing only on such ground counts its own vertical extent as its height above ground.
   double max_extrapolation_m = 20.0;
+  // A point's ground: its bin's plane interpolated, by distance from the point to where each was fitted, with
+  // the plane of the bin beyond it on its side (outside it or inside it) when that was fitted to points of its
+  // own. Far out a bin's plane is fitted to one ring's arc of returns and carried to the bin's edge; the next
+  // ring out, metres away, is where the ground there was measured: without this a ring's slice of a ridge at
+  // a bin's outer edge stands tenths of a metre above a plane that the bin beyond contradicts.
+  bool blend_radial = true;
   double sensor_height_m = 0.95;  // the LiDAR above flat ground; the loader copies lidar.mounting.z_m
 };
 
@@ -76,16 +82,27 @@ struct GroundParams {
 // beam_factor * r * tan(beam_spacing_deg))) at 3D range r; two points join when nearer than the larger of
 // their radii. Structure: KdTree (as PCL's EuclideanClusterExtraction) or Grid (cells of the radius); both
 // give the same clusters.
-enum class ClusterMethod : std::uint8_t { Fixed = 0, Adaptive = 1 };
+// Anisotropic: two radii per point, both adaptive with range: a vertical one (the adaptive radius above: rings
+// are stacked vertically, their gap grows with range) and a horizontal one (horizontal_beam_factor,
+// horizontal_max_tolerance_m; same floor tolerance_m); two points join when (dxy / H)^2 + (dz / V)^2 < 1 with H
+// and V the larger of their two horizontal and vertical radii. The ring slices of a porous crown far out join
+// while two crowns side by side a few tenths of a metre apart stay two.
+enum class ClusterMethod : std::uint8_t { Fixed = 0, Adaptive = 1, Anisotropic = 2 };
 enum class ClusterStructure : std::uint8_t { KdTree = 0, Grid = 1 };
 
 struct ClusterParams {
-  ClusterMethod method = ClusterMethod::Adaptive;
+  ClusterMethod method = ClusterMethod::Anisotropic;
   ClusterStructure structure = ClusterStructure::Grid;
-  double tolerance_m = 0.6;        // Euclidean clustering radius (fixed), smallest radius (adaptive)
-  double beam_spacing_deg = 1.33;  // vertical angle between adjacent rings (HDL-32E: 1.33)
-  double beam_factor = 1.3;        // adaptive radius as a multiple of the gap between adjacent rings
-  double max_tolerance_m = 1.2;    // adaptive radius cap
+  double tolerance_m = 0.4;             // Euclidean clustering radius (fixed), smallest radius (adaptive, anisotropic)
+  double beam_spacing_deg = 1.33;       // vertical angle between adjacent rings (HDL-32E: 1.33)
+  double beam_factor = 4.0;             // adaptive (anisotropic: vertical) radius as a multiple of the ring gap
+  double max_tolerance_m = 3.0;         // adaptive (anisotropic: vertical) radius cap
+  double horizontal_beam_factor = 1.7;  // anisotropic: horizontal radius as beam_factor is for the vertical
+  double horizontal_max_tolerance_m = 1.5;  // anisotropic: horizontal radius cap
+  // After clustering (cluster_absorb.hpp): a cluster of at most absorb_max_points points whose box lies inside a
+  // bigger cluster's box grown by absorb_margin_m joins it. 0 = off.
+  int absorb_max_points = 10;
+  double absorb_margin_m = 0.3;
 };
 
 struct FilterParams {
@@ -98,6 +115,18 @@ struct FilterParams {
   // min_points * (min_points_full_range_m / d)^2, never below min_points_floor. 0 = off.
   double min_points_full_range_m = 12.0;
   int min_points_floor = 2;
+  // Crop canopy (canopy.hpp): a cluster no higher than canopy_max_height_m above its ground whose ring jitter
+  // is at least canopy_min_jitter_m, over at least canopy_min_triples triples of ring neighbours no farther
+  // apart than canopy_max_gap_m, is porous: a crop or low foliage, not an obstacle. Anything standing higher
+  // (a person in the crop: 1.75 m) keeps the whole cluster. canopy_max_height_m 0 = off.
+  double canopy_max_height_m = 0.9;
+  double canopy_min_jitter_m = 0.12;
+  int canopy_min_triples = 16;
+  double canopy_max_gap_m = 0.5;
+  // ... or (with any number of triples) reaches at least canopy_needle_depth_m along the rays and at least
+  // canopy_needle_ratio times as deep as it is wide across them: a ray's returns inside a canopy. 0 = off.
+  double canopy_needle_depth_m = 0.35;
+  double canopy_needle_ratio = 3.0;
 };
 
 // The 2D LiDAR's near field (near_field.hpp): the scan points of a merged frame become obstacles of their own,

@@ -17,7 +17,9 @@
 // building do not). Otherwise it continues the prior's plane. Once every bin is done, a bin without its own
 // plane gets the planes around it (continued from inside, the first fitted bin outside it, the nearest fitted
 // ones either side in its ring) blended by inverse distance. Every point then gets its height above its bin's
-// plane, is ground below ground_threshold_m, and is flagged `guessed` where its bin's ground lies farther than
+// plane (with blend_radial: that plane interpolated with the fitted plane of the bin beyond it on the point's
+// side, inwards or outwards, by distance from the point to where each was fitted), is ground below
+// ground_threshold_m, and is flagged `guessed` where its bin's ground lies farther than
 // max_extrapolation_m from any measured ground. The surface is kept: ground_z(x, y) answers for any (x, y).
 // Thread-compatible.
 
@@ -77,6 +79,7 @@ class ZoneGround {
                                   double prior_per_point) const;
   void gather(const Cloud& in, std::uint32_t k0, std::uint32_t k1);
   void interpolate_gaps();
+  [[nodiscard]] float blended_z(std::uint32_t bin, float x, float y) const;
 
   ZoneParams params_;
   std::vector<Zone> zones_;
