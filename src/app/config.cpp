@@ -215,10 +215,11 @@ void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
 
 void read_ground(YamlReader& r, const YAML::Node& g, perception::GroundParams& p) {
   const std::string path = "perception.ground";
-  if (!r.section(g, path, {"method", "ransac", "zones"})) return;
+  if (!r.section(g, path, {"method", "context_m", "ransac", "zones"})) return;
   if (auto m = r.choice(g, path, "method", {"ransac", "zones"})) {
     p.method = *m == 0 ? perception::GroundMethod::Ransac : perception::GroundMethod::Zones;
   }
+  r.number(g, path, "context_m", p.context_m, 0.0, 100.0, "m");
   const YAML::Node rs = g["ransac"];
   const std::string rp = path + ".ransac";
   if (r.section(rs, rp, {"iterations", "distance_m", "seed"})) {

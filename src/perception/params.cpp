@@ -11,6 +11,7 @@ PipelineParams published_params() {
   p.body = Box3{{-5.0, -1.5, -1.5}, {0.4, 1.5, 1.5}};
   p.ground.method = GroundMethod::Ransac;
   p.ground.ransac = RansacParams{60, 0.3, 42};
+  p.ground.context_m = 0.0;
   p.cluster.method = ClusterMethod::Fixed;
   p.cluster.structure = ClusterStructure::KdTree;
   p.cluster.tolerance_m = 0.6;

@@ -77,9 +77,19 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   // ROI and body box, then the voxel grid. (One pass doing both measured no faster: the cropped cloud stays
   // in cache between the two.) A merged frame's 2D LiDAR points go to the near-field stage only (its one plane
   // of points would be ground, or too few and too low for the 3D filters): the crop sets them aside.
-  crop_box(points, m.params.roi, m.params.body, m.cropped, m.points2d);
+  // The crop keeps the ground stage's context beyond the ROI's far end too; those points are ground or nothing.
+  const float roi_far = static_cast<float>(m.params.roi.max[0]);
+  Box3 crop = m.params.roi;
+  crop.max[0] += m.params.ground.context_m;
+  crop_box(points, crop, m.params.body, m.cropped, m.points2d);
   result.counts.input = static_cast<std::uint32_t>(points.size() - m.points2d.size());
-  result.counts.after_roi = static_cast<std::uint32_t>(m.cropped.size());
+  if (m.params.ground.context_m > 0.0) {
+    std::uint32_t in_roi = 0;
+    for (const float x : m.cropped.x) in_roi += x <= roi_far ? 1U : 0U;
+    result.counts.after_roi = in_roi;
+  } else {
+    result.counts.after_roi = static_cast<std::uint32_t>(m.cropped.size());
+  }
   m.voxel.filter(m.cropped, m.voxels);
   const std::size_t n = m.voxels.size();
   result.counts.after_voxel = static_cast<std::uint32_t>(n);
@@ -105,6 +115,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
       ++ground_count;
       continue;
     }
+    if (m.voxels.x[i] > roi_far) continue;  // ground context only
     m.above.push_back(m.voxels.x[i], m.voxels.y[i], m.voxels.z[i]);
     m.above_index.push_back(static_cast<std::uint32_t>(i));
     m.above_height.push_back(m.ground.height_m[i]);

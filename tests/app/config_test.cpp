@@ -112,6 +112,7 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(z.min_spread_m, dz.min_spread_m);
   EXPECT_EQ(z.max_extrapolation_m, dz.max_extrapolation_m);
   EXPECT_EQ(z.sensor_height_m, dz.sensor_height_m);  // lidar.mounting.z_m 0.95
+  EXPECT_EQ(p.ground.context_m, d.ground.context_m);
   EXPECT_EQ(p.cluster.method, d.cluster.method);
   EXPECT_EQ(p.cluster.structure, d.cluster.structure);
   EXPECT_EQ(p.cluster.tolerance_m, d.cluster.tolerance_m);
@@ -460,6 +461,19 @@ TEST(ConfigLoad, ReportsBadAnisotropicClusterKeys) {
   EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_margin_m", "out of range", 9)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_points", "unknown key", 10)) << dump(r);
   EXPECT_EQ(r.issues.size(), 5U) << dump(r);
+}
+
+// The ground stage's context beyond the ROI: read, range-checked; published.yaml keeps it off.
+TEST(ConfigLoad, ReadsTheGroundContext) {
+  const auto r = load_config_text("perception:\n  ground:\n    context_m: 7.5\n", "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  EXPECT_DOUBLE_EQ(r.config.perception.ground.context_m, 7.5);
+  const auto bad = load_config_text("perception:\n  ground:\n    context_m: -1\n", "bad.yaml");
+  EXPECT_TRUE(has_issue(bad, "perception.ground.context_m", "out of range", 3)) << dump(bad);
+  EXPECT_EQ(bad.issues.size(), 1U) << dump(bad);
+  const auto published = load_config_file(std::string(FIELDGUARD_SOURCE_DIR) + "/config/published.yaml");
+  ASSERT_TRUE(published.ok()) << dump(published);
+  EXPECT_EQ(published.config.perception.ground.context_m, 0.0);
 }
 
 }  // namespace

@@ -152,6 +152,42 @@ TEST(Pipeline, PedestrianAtThirtyMetres) {
   EXPECT_TRUE(published.process(pts).obstacles.empty());
 }
 
+// Far out only a ring or two reach the ground. Here the ground is flat to 38 m, then climbs 6 %; no return
+// landed on it between 38 and 50 m (the ROI's far end), one ring's arc did at 50-60 m, and a 0.3 m clod
+// stands on the climb at 49.4 m. Without the ground beyond the ROI the clod is measured against the flat
+// plane carried on (about 1 m high: an obstacle); with it, against the climb (terrain). A 1 m box at 55 m,
+// beyond the ROI, is ground context only: never an obstacle, never counted in after_roi.
+TEST(Pipeline, GroundBeyondTheRegionOfInterestIsContextOnly) {
+  Cloud c;
+  constexpr float kSlope = 0.06F;
+  constexpr float kFloor = -0.95F;
+  const auto ground_at = [&](float x) { return x <= 38.F ? kFloor : kFloor + kSlope * (x - 38.F); };
+  testing::add_plane(c, 0.F, 0.F, kFloor, 2.F, 38.F, -4.F, 4.F, 0.2F);
+  testing::add_plane(c, kSlope, 0.F, kFloor - kSlope * 38.F, 50.5F, 60.F, -4.F, 4.F, 0.2F);
+  testing::add_block(c, {49.2F, 1.0F, ground_at(49.2F) + 0.02F}, {3, 4, 4}, 0.1F);       // the clod, 0.3 m
+  testing::add_block(c, {55.F, -1.F, ground_at(55.F) + 0.05F}, {4, 4, 10}, 0.1F);        // a 1 m box beyond
+  const std::vector<LidarPoint> pts = testing::to_lidar(c);
+  std::size_t in_roi = 0;
+  for (const LidarPoint& p : pts) in_roi += p.x <= 50.F ? 1U : 0U;
+
+  PipelineParams without;
+  without.ground.context_m = 0.0;
+  const FrameResult cut = Pipeline(without).process(pts);
+  ASSERT_EQ(cut.obstacles.size(), 1U) << "the clod against the flat ground carried on";
+  EXPECT_NEAR(cut.obstacles[0].distance_m, 49.2F, 0.3F);
+  EXPECT_GT(cut.obstacles[0].height_above_ground_m, 0.8F);
+  EXPECT_EQ(cut.counts.after_roi, in_roi);
+
+  PipelineParams with;
+  with.ground.context_m = 15.0;
+  const FrameResult seen = Pipeline(with).process(pts);
+  EXPECT_TRUE(seen.obstacles.empty()) << "nearest: " << (seen.obstacles.empty() ? 0.F : seen.obstacles[0].distance_m)
+                                      << " m, " << (seen.obstacles.empty() ? 0.F : seen.obstacles[0].height_above_ground_m)
+                                      << " m high";
+  EXPECT_EQ(seen.counts.after_roi, in_roi);
+  EXPECT_GT(seen.counts.after_voxel, cut.counts.after_voxel) << "the context went into the ground stage";
+}
+
 TEST(Pipeline, LargeObjectsAreLarge) {
   sim::Scene scene;
   // An implement 4 m x 2.6 m turned so that its long side faces the sensor: the footprint's rectangle

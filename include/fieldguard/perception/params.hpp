@@ -75,6 +75,11 @@ struct GroundParams {
   GroundMethod method = GroundMethod::Zones;
   RansacParams ransac;
   ZoneParams zones;
+  // The ground stage also sees the points up to this far beyond the region of interest's far end (+x, m); they
+  // are never clustered. Far out only one or two rings reach the ground, and the ground at the ROI's edge is
+  // measured by the returns just beyond it: cut there, a ring's slice of a clod at the edge stands above a
+  // plane carried on from metres nearer.
+  double context_m = 15.0;
 };
 
 // Euclidean clustering. Fixed: one radius. Adaptive: the radius grows with range so that a sensor's rings,
