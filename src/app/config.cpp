@@ -255,27 +255,25 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   r.number(c, path, "horizontal_max_tolerance_m", p.horizontal_max_tolerance_m, 0.01, 10.0, "m");
   r.integer(c, path, "absorb_max_points", p.absorb_max_points, 0, 1000000);
   r.number(c, path, "absorb_margin_m", p.absorb_margin_m, 0.0, 10.0, "m");
+  // A radius that grows with range: from tolerance_m up to its cap, by factor * tan(beam_spacing) per metre.
+  const auto check_growth = [&](const char* cap_key, double cap, const char* factor_key, double factor,
+                                const char* which) {
+    if (cap < p.tolerance_m) {
+      r.issue(value_or(c, cap_key), path + "." + cap_key,
+              std::string("must not be less than tolerance_m; the ") + which + " radius grows from tolerance_m up to it");
+    }
+    if (factor * std::tan(p.beam_spacing_deg * std::numbers::pi / 180.0) >= 0.5) {
+      r.issue(value_or(c, factor_key), path + "." + factor_key,
+              std::string(factor_key) + " * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a "
+              "metre per metre of range); lower " + factor_key);
+    }
+  };
   if (p.method == perception::ClusterMethod::Anisotropic) {
-    if (p.horizontal_max_tolerance_m < p.tolerance_m) {
-      r.issue(value_or(c, "horizontal_max_tolerance_m"), path + ".horizontal_max_tolerance_m",
-              "must not be less than tolerance_m; the horizontal radius grows from tolerance_m up to it");
-    }
-    if (p.horizontal_beam_factor * std::tan(p.beam_spacing_deg * std::numbers::pi / 180.0) >= 0.5) {
-      r.issue(value_or(c, "horizontal_beam_factor"), path + ".horizontal_beam_factor",
-              "horizontal_beam_factor * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a "
-              "metre per metre of range); lower horizontal_beam_factor");
-    }
+    check_growth("horizontal_max_tolerance_m", p.horizontal_max_tolerance_m, "horizontal_beam_factor",
+                 p.horizontal_beam_factor, "horizontal");
   }
   if (p.method != perception::ClusterMethod::Fixed) {
-    if (p.max_tolerance_m < p.tolerance_m) {
-      r.issue(value_or(c, "max_tolerance_m"), path + ".max_tolerance_m",
-              "must not be less than tolerance_m; the adaptive radius grows from tolerance_m up to it");
-    }
-    if (p.beam_factor * std::tan(p.beam_spacing_deg * std::numbers::pi / 180.0) >= 0.5) {
-      r.issue(value_or(c, "beam_factor"), path + ".beam_factor",
-              "beam_factor * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a metre per "
-              "metre of range); lower beam_factor");
-    }
+    check_growth("max_tolerance_m", p.max_tolerance_m, "beam_factor", p.beam_factor, "adaptive");
   }
 }
 

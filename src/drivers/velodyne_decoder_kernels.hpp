@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/core/vec4.hpp"
 
 namespace fieldguard::velodyne::kernels {
 
@@ -109,7 +110,7 @@ inline std::int32_t load_le32_unchecked(const std::uint8_t* p) {
 
 // Four floats in one vector register: the vector extension of GCC and Clang, lowered to SSE2 on x86-64, NEON on
 // ARM, scalar code elsewhere; no -march needed. __builtin_shufflevector: GCC 12 and later, Clang.
-using Vec4f = float __attribute__((vector_size(16)));
+using Vec4f = vec4::f32x4;
 using Vec4i = std::int32_t __attribute__((vector_size(16)));
 
 inline Vec4f load4(const void* p) {
@@ -118,17 +119,7 @@ inline Vec4f load4(const void* p) {
   return v;
 }
 
-// Transposes the 4 x 4 matrix whose rows are a, b, c, d.
-inline void transpose4(Vec4f& a, Vec4f& b, Vec4f& c, Vec4f& d) {
-  const Vec4f t0 = __builtin_shufflevector(a, b, 0, 4, 1, 5);
-  const Vec4f t1 = __builtin_shufflevector(a, b, 2, 6, 3, 7);
-  const Vec4f t2 = __builtin_shufflevector(c, d, 0, 4, 1, 5);
-  const Vec4f t3 = __builtin_shufflevector(c, d, 2, 6, 3, 7);
-  a = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
-  b = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
-  c = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
-  d = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
-}
+using vec4::transpose4;
 
 // A LidarPoint is written as two 16-byte halves: (x, y, z, intensity) and (time_s, range_m, w2, w3), where w2 and
 // w3 are the 32-bit words holding (azimuth_cdeg, ring) and (return_type, source, reserved1).
