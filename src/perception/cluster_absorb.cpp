@@ -76,26 +76,14 @@ std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
     for (const std::uint32_t i : clusters[c]) of_point_[i] = target_[c];
   }
   id_.assign(nc, kNone);
-  count_.clear();
   std::uint32_t out_clusters = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (of_point_[i] == kNone) continue;
     std::uint32_t& id = id_[of_point_[i]];
-    if (id == kNone) {
-      id = out_clusters++;
-      count_.push_back(0U);
-    }
-    ++count_[id];
+    if (id == kNone) id = out_clusters++;
     of_point_[i] = id;
   }
-  clusters.offsets.resize(out_clusters + 1);
-  clusters.offsets[0] = 0;
-  for (std::uint32_t c = 0; c < out_clusters; ++c) clusters.offsets[c + 1] = clusters.offsets[c] + count_[c];
-  clusters.indices.resize(clusters.offsets[out_clusters]);
-  for (std::uint32_t c = 0; c < out_clusters; ++c) count_[c] = clusters.offsets[c];
-  for (std::size_t i = 0; i < n; ++i) {
-    if (of_point_[i] != kNone) clusters.indices[count_[of_point_[i]]++] = static_cast<std::uint32_t>(i);
-  }
+  group_points({of_point_.data(), n}, out_clusters, kNone, clusters, count_);
   return moved;
 }
 

@@ -381,23 +381,32 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) pos_of_[gp[j].index] = c;
   }
   std::uint32_t clusters = 0;
-  col_next_.clear();  // reused: the size of each cluster
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t root = find_root(parent, pos_of_[i]);
-    std::uint32_t& id = cluster_of_root_[root];
-    if (id == kNoCluster) {
-      id = clusters++;
-      col_next_.push_back(0U);
-    }
-    ++col_next_[id];
+    std::uint32_t& id = cluster_of_root_[find_root(parent, pos_of_[i])];
+    if (id == kNoCluster) id = clusters++;
     cell_of_[i] = id;
   }
-  out.offsets.resize(clusters + 1);
+  group_points({cell_of_.data(), n}, clusters, kNoCluster, out, col_next_);
+}
+
+void group_points(std::span<const std::uint32_t> cluster_of_point, std::uint32_t count, std::uint32_t none,
+                  Clusters& out, Buffer<std::uint32_t>& scratch) {
+  scratch.assign(count, 0U);  // the size of each cluster, then where its next member goes
+  std::size_t members = 0;
+  for (const std::uint32_t c : cluster_of_point) {
+    if (c == none) continue;
+    ++scratch[c];
+    ++members;
+  }
+  out.offsets.resize(count + 1);
   out.offsets[0] = 0;
-  for (std::uint32_t c = 0; c < clusters; ++c) out.offsets[c + 1] = out.offsets[c] + col_next_[c];
-  out.indices.resize(n);
-  for (std::uint32_t c = 0; c < clusters; ++c) col_next_[c] = out.offsets[c];
-  for (std::size_t i = 0; i < n; ++i) out.indices[col_next_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+  for (std::uint32_t c = 0; c < count; ++c) out.offsets[c + 1] = out.offsets[c] + scratch[c];
+  out.indices.resize(members);
+  for (std::uint32_t c = 0; c < count; ++c) scratch[c] = out.offsets[c];
+  for (std::size_t i = 0; i < cluster_of_point.size(); ++i) {
+    const std::uint32_t c = cluster_of_point[i];
+    if (c != none) out.indices[scratch[c]++] = static_cast<std::uint32_t>(i);
+  }
 }
 
 }  // namespace fieldguard::perception

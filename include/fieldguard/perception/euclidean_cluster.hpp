@@ -32,6 +32,11 @@ struct Clusters {
   }
 };
 
+// Clusters from each point's cluster number (0 .. count - 1, or `none`: the point is in no cluster), each
+// cluster's members ascending (a counting sort). `scratch` is reused.
+void group_points(std::span<const std::uint32_t> cluster_of_point, std::uint32_t count, std::uint32_t none,
+                  Clusters& out, Buffer<std::uint32_t>& scratch);
+
 class EuclideanClusterer {
  public:
   // Throws std::invalid_argument for a radius that is not positive, or an adaptive growth of 0.5 m per metre
