@@ -61,16 +61,17 @@ EuclideanClusterer::EuclideanClusterer(const ClusterParams& params) : params_(pa
   }
 }
 
+// A radius that grows with range: tolerance_m up close, `growth` per metre of range farther out, at most `cap`.
+float EuclideanClusterer::grown(float growth, float cap, float range_m) const {
+  return std::min(cap, std::max(static_cast<float>(params_.tolerance_m), growth * range_m));
+}
+
 float EuclideanClusterer::horizontal_radius_at(float range_m) const {
-  if (!anisotropic_) return radius_at(range_m);
-  const auto t = static_cast<float>(params_.tolerance_m);
-  return std::min(cap_h_, std::max(t, growth_h_ * range_m));
+  return anisotropic_ ? grown(growth_h_, cap_h_, range_m) : radius_at(range_m);
 }
 
 float EuclideanClusterer::radius_at(float range_m) const {
-  const auto t = static_cast<float>(params_.tolerance_m);
-  if (!adaptive_) return t;
-  return std::min(cap_, std::max(t, growth_ * range_m));
+  return adaptive_ ? grown(growth_, cap_, range_m) : static_cast<float>(params_.tolerance_m);
 }
 
 void EuclideanClusterer::extract(const Cloud& in, Clusters& out) {
@@ -96,29 +97,24 @@ void EuclideanClusterer::prepare(const Cloud& in) {
   if (!adaptive_) return;
   r2_.resize(n);
   query_.resize(n);
+  if (anisotropic_) h2_.resize(n);
   const auto t = static_cast<float>(params_.tolerance_m);
-  if (anisotropic_) {
-    // Each radius is at most max(t, g * range) capped, with g the larger growth: the same bound holds with g.
-    h2_.resize(n);
-    const float g = std::max(growth_, growth_h_);
-    const float reach = g / (1.F - g);
-    const float cap = std::max(cap_, cap_h_);
-    for (std::size_t i = 0; i < n; ++i) {
-      const float range = std::sqrt(in.x[i] * in.x[i] + in.y[i] * in.y[i] + in.z[i] * in.z[i]);
-      const float v = std::min(cap_, std::max(t, growth_ * range));
-      const float h = std::min(cap_h_, std::max(t, growth_h_ * range));
-      r2_[i] = v == t ? base_r2_ : v * v;
-      h2_[i] = h == t ? base_r2_ : h * h;
-      query_[i] = std::max(std::max(v, h), std::min(cap, reach * range));
-    }
-    return;
-  }
-  const float reach = growth_ / (1.F - growth_);
+  // Anisotropic: each radius is at most max(t, g * range) capped, with g the larger growth and the larger cap,
+  // so the same bound holds with those.
+  const float g = anisotropic_ ? std::max(growth_, growth_h_) : growth_;
+  const float cap = anisotropic_ ? std::max(cap_, cap_h_) : cap_;
+  const float reach = g / (1.F - g);
   for (std::size_t i = 0; i < n; ++i) {
     const float range = std::sqrt(in.x[i] * in.x[i] + in.y[i] * in.y[i] + in.z[i] * in.z[i]);
-    const float r = std::min(cap_, std::max(t, growth_ * range));
-    r2_[i] = r == t ? base_r2_ : r * r;
-    query_[i] = std::max(r, std::min(cap_, reach * range));
+    const float v = grown(growth_, cap_, range);
+    r2_[i] = v == t ? base_r2_ : v * v;
+    float farthest = v;
+    if (anisotropic_) {
+      const float h = grown(growth_h_, cap_h_, range);
+      h2_[i] = h == t ? base_r2_ : h * h;
+      farthest = std::max(v, h);
+    }
+    query_[i] = std::max(farthest, std::min(cap, reach * range));
   }
 }
 

@@ -49,5 +49,4 @@ void limit_height_to_extent(ClusterSummary& s, float floor_z);
 [[nodiscard]] Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
                                      std::span<const std::uint32_t> indices, RingJitterMeter& meter);
 
-
 }  // namespace fieldguard::perception

@@ -56,6 +56,7 @@ class EuclideanClusterer {
   void extract_kdtree(const Cloud& in, Clusters& out);
   void extract_grid(const Cloud& in, Clusters& out);
   void finish_cluster(Clusters& out);
+  [[nodiscard]] float grown(float growth, float cap, float range_m) const;
   // Inside the ellipsoid of horizontal radius sqrt(h2), vertical sqrt(v2): dxy2 / h2 + dz2 / v2 < 1, without
   // dividing.
   static bool joins_anisotropic(float dxy2, float dz2, float h2, float v2) { return dxy2 * v2 + dz2 * h2 < h2 * v2; }
