@@ -111,7 +111,7 @@ inline std::int32_t load_le32_unchecked(const std::uint8_t* p) {
 // Four floats in one vector register: the vector extension of GCC and Clang, lowered to SSE2 on x86-64, NEON on
 // ARM, scalar code elsewhere; no -march needed. __builtin_shufflevector: GCC 12 and later, Clang.
 using Vec4f = vec4::f32x4;
-using Vec4i = std::int32_t __attribute__((vector_size(16)));
+using Vec4i = vec4::i32x4;
 
 inline Vec4f load4(const void* p) {
   Vec4f v;

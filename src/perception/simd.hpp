@@ -15,7 +15,7 @@
 namespace fieldguard::perception::simd {
 
 using vec4::f32x4;
-using i32x4 = std::int32_t __attribute__((vector_size(16)));
+using vec4::i32x4;
 
 inline f32x4 load(const float* p) {
   f32x4 v;

@@ -1,10 +1,14 @@
 #pragma once
-// Four-lane float vectors (GCC and Clang vector extensions), for the few kernels that work on four points at a
-// time: the Velodyne decoder's and perception's. Plain C++ otherwise; no intrinsics header, no target flags.
+// Four-lane float and int vectors (GCC and Clang vector extensions), for the few kernels that work on four
+// points at a time: the Velodyne decoder's and perception's. Plain C++ otherwise; no intrinsics header, no
+// target flags.
+
+#include <cstdint>
 
 namespace fieldguard::vec4 {
 
 using f32x4 = float __attribute__((vector_size(16)));
+using i32x4 = std::int32_t __attribute__((vector_size(16)));  // a comparison of two f32x4: -1 (true) or 0
 
 // Transposes the 4 x 4 matrix whose rows are a, b, c, d (_MM_TRANSPOSE4_PS): four points' x, y, z, w into an
 // x, a y, a z and a w vector, or back.

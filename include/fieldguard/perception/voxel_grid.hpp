@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 
+#include "fieldguard/core/vec4.hpp"
 #include "fieldguard/perception/cloud.hpp"
 #include "fieldguard/perception/params.hpp"
 
@@ -35,7 +36,7 @@ class VoxelGrid {
     float x, y, z;
     std::uint32_t n;
   };
-  using Vec4 = float __attribute__((vector_size(16)));  // = simd::f32x4 (src/perception/simd.hpp)
+  using Vec4 = vec4::f32x4;
   struct CacheEntry {
     Vec4 sum;  // x, y, z, (unused)
     std::uint64_t key;
