@@ -6,6 +6,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "perception/simd.hpp"
+
 namespace fieldguard::perception {
 namespace {
 
@@ -24,6 +26,38 @@ inline std::uint32_t find_root(std::uint32_t* parent, std::uint32_t c) {
     c = parent[c];
   }
   return c;
+}
+
+// Whether a point of [a0, a1) and one of [b0, b1) join (grid order; coordinates and radii squared per point,
+// padded by four): each point of the first against four of the second at a time. Lane by lane the same
+// operations in the same order as the scalar tests (EuclideanClusterer::joins_anisotropic, d^2 < r^2), so the
+// same answers to the bit.
+bool cells_join(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint32_t b1, const float* sx,
+                const float* sy, const float* sz, const float* r2, const float* h2, bool aniso) {
+  using simd::f32x4;
+  const auto lanes = static_cast<std::int32_t>(b1 - b0);
+  for (std::uint32_t i = a0; i < a1; ++i) {
+    const f32x4 px = simd::splat(sx[i]), py = simd::splat(sy[i]), pz = simd::splat(sz[i]);
+    const f32x4 pv = simd::splat(r2[i]), ph = simd::splat(h2[i]);
+    simd::i32x4 lane = {0, 1, 2, 3};
+    for (std::uint32_t j = b0; j < b1; j += 4, lane += 4) {
+      const f32x4 dx = simd::load(sx + j) - px, dy = simd::load(sy + j) - py, dz = simd::load(sz + j) - pz;
+      const f32x4 dxy2 = dx * dx + dy * dy;
+      const f32x4 qv = simd::load(r2 + j);
+      const f32x4 v = pv < qv ? qv : pv;  // std::max(r2[i], r2[j])
+      simd::i32x4 hit;
+      if (aniso) {
+        const f32x4 qh = simd::load(h2 + j);
+        const f32x4 h = ph < qh ? qh : ph;
+        hit = dxy2 * v + (dz * dz) * h < h * v;
+      } else {
+        hit = dxy2 + dz * dz < v;
+      }
+      hit &= lane < simd::splat(lanes);  // lanes past b1 are another cell's points or padding
+      if (simd::mask_bits(hit) != 0U) return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -264,23 +298,47 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   grid_points_.resize(n);
   col_next_.assign(col_start_.begin(), col_start_.begin() + static_cast<std::ptrdiff_t>(cols));
   for (std::size_t k = 0; k < n; ++k) grid_points_[col_next_[cell_of_[k]]++] = by_z_[k];
-  // Cells: runs of one z cell in a column.
+  // Cells: runs of k z cells in a column. Far out the radii are larger than the cube's diagonal: a column whose
+  // every point is at least rmin away (horizontally, so in 3D too) may stack k z cells into one taller cell
+  // whose points still all join with the smallest radii at rmin (each axis's extent taken 2 * rounding long).
+  // Fewer, taller cells: far walls cost fewer cell pairs.
   cells_.clear();
   col_cells_.resize(cols + 1);
   GridPoint* gp = grid_points_.data();
+  const double e = static_cast<double>(edge), rho2 = 2.0 * static_cast<double>(rounding);
+  const auto stack_of = [&](std::size_t c) -> std::uint32_t {
+    if (!adaptive_) return 1;
+    const double x0 = static_cast<double>(lo[0]) + static_cast<double>(c / ny) * e - rho2;
+    const double y0 = static_cast<double>(lo[1]) + static_cast<double>(c % ny) * e - rho2;
+    const double dx = std::max({0.0, x0, -(x0 + e + 2.0 * rho2)});
+    const double dy = std::max({0.0, y0, -(y0 + e + 2.0 * rho2)});
+    const auto rmin = static_cast<float>(std::sqrt(dx * dx + dy * dy));
+    const auto v = static_cast<double>(grown(growth_, cap_, rmin));
+    const double h = anisotropic_ ? static_cast<double>(grown(growth_h_, cap_h_, rmin)) : v;
+    const double across = 2.0 * (e + rho2) * (e + rho2) / (h * h);
+    if (!(across < 0.998)) return 1;
+    const double height = std::sqrt((0.998 - across) * v * v) - rho2;  // the tallest cell allowed
+    return static_cast<std::uint32_t>(std::clamp(std::floor(height / e), 1.0, 64.0));
+  };
   for (std::size_t c = 0; c < cols; ++c) {
     col_cells_[c] = static_cast<std::uint32_t>(cells_.size());
-    const std::uint32_t b = col_start_[c], e = col_start_[c + 1];
-    for (std::uint32_t j = b; j < e; ++j) {
-      if (j == b || gp[j].iz != gp[j - 1].iz)
-        cells_.push_back(Cell{j, static_cast<std::uint32_t>(c), gp[j].iz, 0.F, 0.F});
+    const std::uint32_t b = col_start_[c], end = col_start_[c + 1];
+    if (b == end) continue;
+    const std::uint32_t k = stack_of(c);
+    std::uint32_t top = 0;  // the last z cell of the current cell
+    for (std::uint32_t j = b; j < end; ++j) {
+      if (j == b || gp[j].iz > top) {
+        const std::uint32_t bottom = gp[j].iz - gp[j].iz % k;
+        top = bottom + k - 1;
+        cells_.push_back(Cell{j, static_cast<std::uint32_t>(c), bottom, top, 0.F, 0.F});
+      }
     }
   }
   col_cells_[cols] = static_cast<std::uint32_t>(cells_.size());
   const auto ncells = static_cast<std::uint32_t>(cells_.size());
-  cells_.push_back(Cell{static_cast<std::uint32_t>(n), 0, 0, 0.F, 0.F});  // sentinel: the end of the last cell
-  sorted_r2_.resize(n);
-  if (anisotropic_) sorted_h2_.resize(n);
+  cells_.push_back(Cell{static_cast<std::uint32_t>(n), 0, 0, 0, 0.F, 0.F});  // sentinel: the end of the last cell
+  sorted_r2_.resize(n + 4);  // padded: the pair test reads four at a time
+  if (anisotropic_) sorted_h2_.resize(n + 4);
   parent_.resize(ncells);
   for (std::uint32_t c = 0; c < ncells; ++c) {
     parent_[c] = c;
@@ -300,11 +358,15 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     cells_[c].hreach2 = anisotropic_ ? mh : m;
   }
 
-  // Joins. From each cell, the cells within its own reach (its points' search radius): of two points, the
-  // one with the larger radius reaches the other, so every joining pair is tested from at least one side.
+  // Joins. Of two cells, the one with the larger radii (both radii grow with range, so a cell's largest
+  // horizontal and vertical radius are those of its farthest point: of two cells, one has both at least as
+  // large as the other's; ties by cell number) looks for the other within its own reach. Its reach covers
+  // every pair the other's would, so each cell pair is looked at once, from that side; of two points, the one
+  // with the larger radius reaches the other, so every joining pair is tested. Dense surfaces join early and
+  // most pairs end at the union-find check.
   std::uint32_t* parent = parent_.data();
   const float* r2 = sorted_r2_.data();
-  const float* h2 = anisotropic_ ? sorted_h2_.data() : nullptr;
+  const float* h2 = anisotropic_ ? sorted_h2_.data() : sorted_r2_.data();
   const bool aniso = anisotropic_;
   // The gap between two cells `d` apart on an axis (a whole cell less, taken short by kSlack), for every
   // offset a cell's reach covers: looked up per neighbour instead of computed.
@@ -317,6 +379,27 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     gaps_[static_cast<std::size_t>(d + max_reach)] = g > 0 ? static_cast<float>(g) * edge - kSlack : 0.F;
   }
   const float* gap_at = gaps_.data() + max_reach;  // gap_at[d], d in [-max_reach, max_reach]
+  // Points in grid order, one array per coordinate (padded: the pair test reads four at a time).
+  grid_xyz_.resize(3 * (n + 4));
+  float* const sx = grid_xyz_.data();
+  float* const sy = sx + n + 4;
+  float* const sz = sy + n + 4;
+  for (std::size_t j = 0; j < n; ++j) {
+    sx[j] = gp[j].x;
+    sy[j] = gp[j].y;
+    sz[j] = gp[j].z;
+  }
+  for (std::size_t j = n; j < n + 4; ++j) sx[j] = sy[j] = sz[j] = 0.F;
+  for (std::size_t j = n; j < n + 4; ++j) {
+    sorted_r2_[j] = 0.F;
+    if (anisotropic_) sorted_h2_[j] = 0.F;
+  }
+  // Whether cell b's radii are below cell a's (the order above: vertical, then horizontal, then number).
+  const auto below = [&](const Cell& cb, std::uint32_t b, const Cell& ca, std::uint32_t a) {
+    if (cb.reach2 != ca.reach2) return cb.reach2 < ca.reach2;
+    if (cb.hreach2 != ca.hreach2) return cb.hreach2 < ca.hreach2;
+    return b < a;
+  };
   for (std::uint32_t a = 0; a < ncells; ++a) {
     const Cell& ca = cells_[a];
     const std::uint32_t a0 = ca.first, a1 = cells_[a + 1].first;
@@ -324,7 +407,13 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     const auto reach = static_cast<std::int64_t>(std::sqrt(reach2) / edge) + 1;
     const auto hreach = static_cast<std::int64_t>(std::sqrt(hreach2) / edge) + 1;
     const auto ax = static_cast<std::int64_t>(ca.col / ny), ay = static_cast<std::int64_t>(ca.col % ny);
-    const auto az = static_cast<std::int64_t>(ca.iz);
+    const auto az = static_cast<std::int64_t>(ca.iz), az_top = static_cast<std::int64_t>(ca.iz_top);
+    // Whether a cell dz z cells away in a column gxy away is within reach. It only turns false as |dz| grows
+    // (the gap grows with the offset), so a column's reachable cells are one run of z cells.
+    const auto within = [&](float gxy, std::int64_t dz) {
+      const float gz = gap_at[dz];
+      return aniso ? joins_anisotropic(gxy, gz * gz, hreach2, reach2) : gxy + gz * gz < reach2;
+    };
     std::uint32_t ra = find_root(parent, a);  // kept up to date: only this loop joins a's root to another
     for (std::int64_t x = std::max<std::int64_t>(0, ax - hreach);
          x <= std::min<std::int64_t>(ax + hreach, static_cast<std::int64_t>(nx) - 1); ++x) {
@@ -332,36 +421,29 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
       for (std::int64_t y = std::max<std::int64_t>(0, ay - hreach);
            y <= std::min<std::int64_t>(ay + hreach, static_cast<std::int64_t>(ny) - 1); ++y) {
         const auto col = static_cast<std::size_t>(x) * ny + static_cast<std::size_t>(y);
-        const std::uint32_t first = col_cells_[col], last = col_cells_[col + 1];
-        if (first == last) continue;  // an empty column (most are)
+        std::uint32_t b = col_cells_[col];
+        const std::uint32_t last = col_cells_[col + 1];
+        if (b == last) continue;  // an empty column (most are)
         const float gy = gap_at[y - ay];
         const float gxy = gx * gx + gy * gy;
-        if (!(gxy < hreach2)) continue;
-        for (std::uint32_t b = first; b < last; ++b) {
+        if (!(gxy < hreach2) || !within(gxy, 0)) continue;
+        // The largest |dz| within reach: first guessed from the ellipse (the gap of d cells is (d - 1) * edge),
+        // then settled by the test itself, so exactly the run the test allows.
+        const float room2 = aniso ? reach2 * (1.F - gxy / hreach2) : reach2 - gxy;
+        std::int64_t lim = room2 > 0.F ? static_cast<std::int64_t>(std::sqrt(room2) * inv) + 1 : 0;
+        lim = std::min(lim, reach);
+        while (lim > 0 && !within(gxy, lim)) --lim;
+        while (lim < reach && within(gxy, lim + 1)) ++lim;
+        const auto z_lo = az - lim, z_hi = az_top + lim;
+        while (b < last && static_cast<std::int64_t>(cells_[b].iz_top) < z_lo) ++b;
+        for (; b < last; ++b) {
           const Cell& cb = cells_[b];
-          if (b == a) continue;
-          const std::int64_t dz = static_cast<std::int64_t>(cb.iz) - az;
-          if (dz > reach) break;  // cells of a column ascend in z
-          if (dz < -reach) continue;
-          const float gz = gap_at[dz];
-          if (aniso ? !joins_anisotropic(gxy, gz * gz, hreach2, reach2) : !(gxy + gz * gz < reach2)) continue;
+          if (static_cast<std::int64_t>(cb.iz) > z_hi) break;  // cells of a column ascend in z
+          // b looks for a (or b is a)
+          if (!below(cb, b, ca, a)) continue;
           const std::uint32_t rb = find_root(parent, b);
           if (ra == rb) continue;
-          const std::uint32_t b0 = cb.first, b1 = cells_[b + 1].first;
-          bool joined = false;
-          for (std::uint32_t i = a0; i < a1 && !joined; ++i) {
-            const GridPoint p = gp[i];
-            for (std::uint32_t j = b0; j < b1; ++j) {
-              const float dx = gp[j].x - p.x, dy = gp[j].y - p.y, dz2 = gp[j].z - p.z;
-              const float dxy2 = dx * dx + dy * dy;
-              if (aniso ? joins_anisotropic(dxy2, dz2 * dz2, std::max(h2[i], h2[j]), std::max(r2[i], r2[j]))
-                        : dxy2 + dz2 * dz2 < std::max(r2[i], r2[j])) {
-                joined = true;
-                break;
-              }
-            }
-          }
-          if (joined) {
+          if (cells_join(a0, a1, cb.first, cells_[b + 1].first, sx, sy, sz, r2, h2, aniso)) {
             parent[std::max(ra, rb)] = std::min(ra, rb);
             ra = std::min(ra, rb);
           }
@@ -371,14 +453,17 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   }
 
   // Clusters in the order of their lowest point index, members ascending: one pass in index order.
+  // A cell's parent is never after it (a join points the later root at the earlier one, and path halving
+  // at an ancestor), so one pass in cell order points every cell at its root.
   cluster_of_root_.assign(ncells, kNoCluster);
-  pos_of_.resize(n);  // cell of each point
+  pos_of_.resize(n);  // root cell of each point
   for (std::uint32_t c = 0; c < ncells; ++c) {
-    for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) pos_of_[gp[j].index] = c;
+    parent[c] = parent[parent[c]];
+    for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) pos_of_[gp[j].index] = parent[c];
   }
   std::uint32_t clusters = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t& id = cluster_of_root_[find_root(parent, pos_of_[i])];
+    std::uint32_t& id = cluster_of_root_[pos_of_[i]];
     if (id == kNoCluster) id = clusters++;
     cell_of_[i] = id;
   }

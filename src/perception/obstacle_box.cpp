@@ -202,6 +202,43 @@ void drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
 
 }  // namespace
 
+namespace {
+
+// How many of `pts` lie within `tol` of a side of the rectangle [u0, u1] x [v0, v1] along the axes (ux, uy)
+// and (-uy, ux): two points at a time in double, lane by lane the operations of the one-point loop at the end
+// (std::min as b < a ? b : a), so the same count.
+std::size_t count_near_sides(std::span<const P2> pts, double ux, double uy, double u0, double u1, double v0, double v1,
+                             double tol) {
+  using f64x2 = double __attribute__((vector_size(16)));
+  using i64x2 = std::int64_t __attribute__((vector_size(16)));
+  using f32x2 = float __attribute__((vector_size(8)));
+  const auto min2 = [](f64x2 a, f64x2 b) { return b < a ? b : a; };
+  const f64x2 vux = {ux, ux}, vuy = {uy, uy}, vu0 = {u0, u0}, vu1 = {u1, u1}, vv0 = {v0, v0}, vv1 = {v1, v1};
+  const f64x2 vtol = {tol, tol};
+  i64x2 near = {0, 0};  // minus the count per lane (a true comparison is -1)
+  const std::size_t n = pts.size();
+  std::size_t i = 0;
+  for (; i + 2 <= n; i += 2) {
+    f32x2 xs = {pts[i][0], pts[i + 1][0]}, ys = {pts[i][1], pts[i + 1][1]};
+    const f64x2 px = __builtin_convertvector(xs, f64x2), py = __builtin_convertvector(ys, f64x2);
+    const f64x2 u = px * vux + py * vuy;
+    const f64x2 v = -px * vuy + py * vux;
+    const f64x2 edge = min2(min2(u - vu0, vu1 - u), min2(v - vv0, vv1 - v));
+    near += edge <= vtol;
+  }
+  std::size_t score = static_cast<std::size_t>(-(near[0] + near[1]));
+  for (; i < n; ++i) {
+    const P2& p = pts[i];
+    const double u = d(p[0]) * ux + d(p[1]) * uy;
+    const double v = -d(p[0]) * uy + d(p[1]) * ux;
+    const double edge = std::min(std::min(u - u0, u1 - u), std::min(v - v0, v1 - v));
+    score += edge <= tol ? 1U : 0U;
+  }
+  return score;
+}
+
+}  // namespace
+
 void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
   hull.clear();
   std::vector<P2>& scratch = hs.points;
@@ -299,13 +336,7 @@ OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, HullS
       break;
     }
     const double tol = std::max(0.05, 0.02 * std::max(c.u1 - c.u0, c.v1 - c.v0));
-    std::size_t score = 0;
-    for (const P2& p : pts) {
-      const double u = d(p[0]) * c.ux + d(p[1]) * c.uy;
-      const double v = -d(p[0]) * c.uy + d(p[1]) * c.ux;
-      const double edge = std::min(std::min(u - c.u0, c.u1 - u), std::min(v - c.v0, c.v1 - v));
-      score += edge <= tol ? 1U : 0U;
-    }
+    const std::size_t score = count_near_sides(pts, c.ux, c.uy, c.u0, c.u1, c.v0, c.v1, tol);
     if (best == nullptr || score > best_score) {
       best = &c;
       best_score = score;

@@ -1,6 +1,7 @@
 #include "fieldguard/perception/voxel_grid.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -40,11 +41,26 @@ inline void block_keys(const float* x, const float* y, const float* z, float s, 
     const simd::i32x4 ix = simd::floor_clamped(simd::load(x + b) * sv, kCoordLimit);
     const simd::i32x4 iy = simd::floor_clamped(simd::load(y + b) * sv, kCoordLimit);
     const simd::i32x4 iz = simd::floor_clamped(simd::load(z + b) * sv, kCoordLimit);
-    std::int32_t vx[4], vy[4], vz[4];
-    std::memcpy(vx, &ix, sizeof vx);
-    std::memcpy(vy, &iy, sizeof vy);
-    std::memcpy(vz, &iz, sizeof vz);
-    for (std::size_t k = 0; k < 4; ++k) keys[b + k] = pack(vx[k], vy[k], vz[k], 1);
+    if constexpr (std::endian::native == std::endian::little) {
+      // pack(x, y, z, 1) four at a time: the keys' low and high 32-bit halves, interleaved into 64 bits.
+      using u32x4 = std::uint32_t __attribute__((vector_size(16)));
+      const auto o = static_cast<std::uint32_t>(kCoordOffset);
+      const u32x4 ux = __builtin_convertvector(ix, u32x4) + o;
+      const u32x4 uy = __builtin_convertvector(iy, u32x4) + o;
+      const u32x4 uz = __builtin_convertvector(iz, u32x4) + o;
+      const u32x4 lo = (uy << 20U) | uz;
+      const u32x4 hi = (ux << 8U) | (uy >> 12U) | (1U << 28U);  // band 1 in the top 4 bits
+      const u32x4 k01 = __builtin_shufflevector(lo, hi, 0, 4, 1, 5);
+      const u32x4 k23 = __builtin_shufflevector(lo, hi, 2, 6, 3, 7);
+      std::memcpy(keys + b, &k01, sizeof k01);
+      std::memcpy(keys + b + 2, &k23, sizeof k23);
+    } else {
+      std::int32_t vx[4], vy[4], vz[4];
+      std::memcpy(vx, &ix, sizeof vx);
+      std::memcpy(vy, &iy, sizeof vy);
+      std::memcpy(vz, &iz, sizeof vz);
+      for (std::size_t k = 0; k < 4; ++k) keys[b + k] = pack(vx[k], vy[k], vz[k], 1);
+    }
   }
 }
 
@@ -131,17 +147,22 @@ void VoxelGrid::begin(std::size_t max_points) {
 // (the runs' 32-bit stores may alias it), a store-to-load chain through memory from one point to the next.
 inline void VoxelGrid::add(std::uint64_t key, std::uint32_t ring, simd::f32x4 p, std::uint32_t& queued) {
   CacheEntry& c = cache_[ring & (kRingCache - 1)];
-  // Without branches on the data (whether a ring stays in its voxel is a coin flip for the predictor): the
-  // entry's run is written to the queue every time, and the queue moves on only when the run has finished.
-  const bool moved = c.key != key;
-  Run& r = runs_[queued];
-  r.sum = c.sum;
-  r.key = c.key;
-  r.n = c.n;
-  queued += (moved && c.key != kNoKey) ? 1U : 0U;
-  const simd::f32x4 keep = moved ? simd::splat(0.F) : c.sum;
-  c.sum = keep + p;  // lanes x, y, z (the fourth is not used)
-  c.n = moved ? 1U : c.n + 1U;
+  // Branching on whether the ring stays in its voxel (85 % of points do) measured 3-7 % faster than writing
+  // the entry's run to the queue on every point (BM_Voxel, g++ -O2, x86-64, one run on a busy machine). The new
+  // run starts from +0 + p, as a sum from zero does (a -0 coordinate becomes +0).
+  if (c.key == key) {
+    c.sum = c.sum + p;  // lanes x, y, z (the fourth is not used)
+    ++c.n;
+    return;
+  }
+  if (c.key != kNoKey) {
+    Run& r = runs_[queued++];
+    r.sum = c.sum;
+    r.key = c.key;
+    r.n = c.n;
+  }
+  c.sum = simd::splat(0.F) + p;
+  c.n = 1U;
   c.key = key;
   if (queued == kRunBatch) [[unlikely]] {
     queued_ = queued;

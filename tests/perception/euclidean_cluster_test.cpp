@@ -349,6 +349,46 @@ TEST(EuclideanClusterer, AnisotropicKdTreeAndGridAgree) {
   EXPECT_EQ(sets_of(a), sets_of(b));
 }
 
+// Far out the grid stacks z cells into taller ones (the radii are large there): two vertical runs of points
+// 30 m out join across a gap just under the vertical radius and stay apart across one just over it, and dense
+// far clouds give the k-d tree's clusters, for both growing radii.
+TEST(EuclideanClusterer, FarTallCellsStayExact) {
+  for (const auto method : {ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
+    const EuclideanClusterer probe(params(method, ClusterStructure::Grid, 0.4));
+    for (const float factor : {0.97F, 1.03F}) {
+      Cloud c;
+      const float x = 30.F;
+      for (int i = 0; i < 8; ++i) c.push_back(x, 0.F, -1.F + 0.15F * static_cast<float>(i));
+      const float top = -1.F + 0.15F * 7.F;
+      const float gap = factor * probe.radius_at(std::sqrt(x * x + top * top));
+      for (int i = 0; i < 8; ++i) c.push_back(x, 0.F, top + gap + 0.15F * static_cast<float>(i));
+      for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+        EuclideanClusterer e(params(method, structure, 0.4));
+        Clusters out;
+        e.extract(c, out);
+        EXPECT_EQ(out.size(), factor < 1.F ? 1U : 2U)
+            << factor << (structure == ClusterStructure::Grid ? " grid" : " kd");
+      }
+    }
+    testing::TestRng rng{33};
+    Cloud c;
+    for (int k = 0; k < 40; ++k) {  // clumps (dense: tall cells of many points) and the odd stray point
+      const float cx = rng.uniform(20, 48), cy = rng.uniform(-10, 10), cz = rng.uniform(-1.5F, 5.F);
+      for (int i = 0; i < 60; ++i) {
+        c.push_back(cx + rng.uniform(-0.4F, 0.4F), cy + rng.uniform(-0.4F, 0.4F), cz + rng.uniform(-0.8F, 0.8F));
+      }
+      c.push_back(cx + rng.uniform(-3, 3), cy + rng.uniform(-3, 3), cz + rng.uniform(-3, 3));
+    }
+    Clusters a, b;
+    EuclideanClusterer kd(params(method, ClusterStructure::KdTree, 0.4));
+    EuclideanClusterer grid(params(method, ClusterStructure::Grid, 0.4));
+    kd.extract(c, a);
+    grid.extract(c, b);
+    EXPECT_GT(a.size(), 5U);
+    EXPECT_EQ(sets_of(a), sets_of(b));
+  }
+}
+
 TEST(EuclideanClusterer, AnisotropicRadii) {
   const EuclideanClusterer e(params(ClusterMethod::Anisotropic, ClusterStructure::Grid, 0.4));
   const float gap = std::tan(1.33F * kDeg);

@@ -8,8 +8,10 @@
 // symmetric, so the clusters do not depend on the search order. Anisotropic: each point has a horizontal and a
 // vertical radius, both growing with range; two points join inside the ellipsoid (dxy / H)^2 + (dz / V)^2 < 1
 // with H and V the larger of their horizontal and vertical radii (again symmetric). Structures: KdTree (our k-d
-// tree, the published way) or Grid (cubic cells small enough that a cell's points always join; union-find over cells,
-// neighbouring cells joined by their first pair within reach). Both find exactly the same clusters.
+// tree, the published way) or Grid (cells small enough that a cell's points always join: cubes, stacked into taller
+// cells far out where the radii allow; union-find over cells, each pair of cells within reach looked at once, from
+// the side with the larger radii, and joined by their first pair within reach, tested four at a time). Both find
+// exactly the same clusters.
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
 
@@ -86,17 +88,19 @@ class EuclideanClusterer {
     std::uint32_t iz;  // z cell
   };
   struct Cell {
-    std::uint32_t first;  // its points: grid_points_[first, next cell's first)
-    std::uint32_t col;    // x-y column
-    std::uint32_t iz;     // z cell
-    float reach2;         // the largest radius of its points, squared (anisotropic: the vertical one)
-    float hreach2;        // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
+    std::uint32_t first;   // its points: grid_points_[first, next cell's first)
+    std::uint32_t col;     // x-y column
+    std::uint32_t iz;      // its lowest z cell
+    std::uint32_t iz_top;  // its highest z cell (far out a cell stacks several: see extract_grid)
+    float reach2;          // the largest radius of its points, squared (anisotropic: the vertical one)
+    float hreach2;         // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
   };
   static constexpr std::uint32_t kNoCluster = 0xFFFFFFFFU;
   Buffer<GridPoint> grid_points_;
   Buffer<GridPoint> by_z_;          // the points sorted by z cell (the first radix pass)
   Buffer<float> sorted_r2_;         // r2_ in grid order
   Buffer<float> sorted_h2_;         // h2_ in grid order (anisotropic)
+  Buffer<float> grid_xyz_;          // x, y, z of the points in grid order, one array each
   Buffer<std::uint32_t> col_next_;  // scratch: per column, then per cluster
   Buffer<Cell> cells_;
   Buffer<std::uint32_t> col_cells_;  // per column: its first cell (cells of a column ascend in z)
