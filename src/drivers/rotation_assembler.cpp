@@ -177,6 +177,37 @@ void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stam
   have_current_ = have;
 }
 
+bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sensor_time, AzimuthRange azimuths) {
+  const std::size_t size = current_.points.size();
+  const std::size_t end = count_ + std::min(count, size - std::min(count_, size));
+  const int cut = cut_cdeg_;
+  const int prev = prev_rel_cdeg_;
+  if (!have_current_ || prev < 0 || end == count_) return false;
+  if (azimuths.min_cdeg > azimuths.max_cdeg || azimuths.max_cdeg >= kFullTurnCdeg) return false;
+  // The azimuth relative to the cut rises with the azimuth over the bounds only if the cut is not inside them.
+  if (azimuths.min_cdeg < cut && cut <= azimuths.max_cdeg) return false;
+  const int lo = std::min(relative_cdeg(azimuths.min_cdeg, cut), prev);
+  const int hi = std::max(relative_cdeg(azimuths.max_cdeg, cut), prev);
+  // commit() cuts where an azimuth falls more than half a turn below the previous one, and holds the reference back
+  // where one lies more than half a turn above it. Neither can happen while every azimuth of the packet and the
+  // reference lie within half a turn of each other: every point then just becomes the reference, the last one last.
+  if (hi - lo > kWrapCdeg) return false;
+  LidarPoint* const pts = current_.points.data();
+  const double packet_to_frame_s = static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
+  for (std::size_t i = count_; i < end; ++i) {
+    pts[i].time_s = static_cast<float>(packet_to_frame_s + static_cast<double>(pts[i].time_s));
+  }
+  ++current_.packets;
+  prev_rel_cdeg_ = relative_cdeg(pts[end - 1].azimuth_cdeg, cut);
+  count_ = end;
+  return true;
+}
+
+void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time,
+                               std::vector<LidarFrame>& done, AzimuthRange azimuths) {
+  if (!commit_within_frame(count, packet_sensor_time, azimuths)) commit(count, packet_sensor_time, packet_host_time, done);
+}
+
 void RotationAssembler::finish(std::vector<LidarFrame>& done) {
   if (have_current_ && count_ > 0) emit(done, true, {});
   current_ = LidarFrame{};

@@ -1,6 +1,7 @@
 // Velodyne HDL-32E / VLP-16 data packet decoder (protocols.md §1.2-§1.8, §1.10).
 #include "fieldguard/drivers/velodyne_decoder.hpp"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -19,14 +20,16 @@ namespace {
 
 using kernels::AzimuthEntry;
 using kernels::azimuth_ring_word;
+using kernels::azimuth_word;
 using kernels::azimuth_table;
 using kernels::load4;
 using kernels::load_le16_unchecked;
 using kernels::load_le32_unchecked;
 using kernels::put_point;
-using kernels::round_cdeg;
+using kernels::round_cdeg32;
 using kernels::round_cdeg_lround;
 using kernels::return_type_word;
+using kernels::ring_word;
 using kernels::transpose4;
 using kernels::Vec4f;
 using kernels::Vec4i;
@@ -150,8 +153,11 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
     slots_.in_block_us[slot] = in_block_us;
     slots_.block_fraction[slot] = in_block_us / lay.block_us;
     slots_.ring[slot] = static_cast<std::uint16_t>(ring < 0 ? 0 : ring);
+    slots_.ring_word[slot] = ring_word(slots_.ring[slot]);
     if (!(std::abs(slots_.rot_cdeg[slot]) < 35000.F)) fast_wrap_ = false;
   }
+  min_rot_cdeg_ = *std::min_element(slots_.rot_cdeg.begin(), slots_.rot_cdeg.end());
+  max_rot_cdeg_ = *std::max_element(slots_.rot_cdeg.begin(), slots_.rot_cdeg.end());
   // Point times relative to the firing the packet timestamp marks, per firing group and slot.
   for (std::size_t dual = 0; dual < 2; ++dual) {
     const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring
@@ -199,7 +205,8 @@ struct GroupAngles {
 // vectorises (azimuths, ranges, coordinates), one that looks the azimuths up in the table, and one that writes the
 // points out.
 template <bool kDual, bool kFastWrap>
-std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst) const {
+std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst,
+                                   AzimuthRange* azimuths) const {
   constexpr std::size_t kStep = kDual ? 2 : 1;               // blocks per firing group
   constexpr std::size_t kGroups = kBlocksPerPacket / kStep;  // firing groups per packet
   constexpr std::size_t kSlots = kSlotsPerBlock;
@@ -221,6 +228,26 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
     fallback = d;
     az[g] = static_cast<float>(az_int[g]);
     delta[g] = static_cast<float>(d);
+  }
+  if (azimuths != nullptr) {
+    *azimuths = AzimuthRange{};
+    if constexpr (kFastWrap) {
+      // Before wrapping, a firing's azimuth is az[g] + delta[g] * block_fraction - rot_cdeg with the fraction in
+      // [0, 1) and delta[g] >= 0: inside [az[g] - max_rot, az[g] + delta[g] - min_rot], give or take the float
+      // rounding (under 0.02 here). One unit of margin either side covers that and the rounding to 0.01 degree;
+      // a range inside [0, 35999] then holds every rounded azimuth, none of them wrapped.
+      float lo = az[0];
+      float hi = az[0] + delta[0];
+      for (std::size_t g = 1; g < kGroups; ++g) {
+        lo = std::min(lo, az[g]);
+        hi = std::max(hi, az[g] + delta[g]);
+      }
+      const float lo_cdeg = std::floor(lo - max_rot_cdeg_) - 1.F;
+      const float hi_cdeg = std::ceil(hi - min_rot_cdeg_) + 1.F;
+      if (lo_cdeg >= 0.F && hi_cdeg <= static_cast<float>(kAzimuthUnits - 1)) {
+        *azimuths = AzimuthRange{static_cast<std::uint16_t>(lo_cdeg), static_cast<std::uint16_t>(hi_cdeg)};
+      }
+    }
   }
 
   const ReturnType single_type = header.return_mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
@@ -244,7 +271,7 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
         const float f = w - static_cast<float>(i);     // exact
         index[s] = i;
         frac[s] = f;
-        out.azimuth_ring[s] = azimuth_ring_word(round_cdeg(i, f), t.ring[s]);
+        out.azimuth_ring[s] = azimuth_word(round_cdeg32(i, f)) | t.ring_word[s];
       }
       // The table look-up, four slots at a time: four entries (cos, sin, dcos, dsin) transposed into a vector of
       // each, then entry + fraction * step (the same float operations as one slot at a time).
@@ -300,12 +327,16 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
 
   // The points of four slots [s, s + 4) of block `bp` as the two 16-byte halves of each (put_point()), by two
   // 4 x 4 transposes of the structure of arrays. `type` holds the four slots' return_type_word()s.
-  auto write4 = [&](const BlockPoints& bp, const GroupAngles& ga, std::size_t s, const Vec4f& type,
-                    std::array<Vec4f, 4>& first, std::array<Vec4f, 4>& second) {
-    first = {load4(&bp.x[s]), load4(&bp.y[s]), load4(&bp.z[s]), load4(&bp.intensity_f[s])};
-    transpose4(first[0], first[1], first[2], first[3]);
-    second = {load4(ga.time_s + s), load4(&bp.range[s]), load4(&ga.azimuth_ring[s]), type};
-    transpose4(second[0], second[1], second[2], second[3]);
+  struct Four {
+    Vec4f a0, a1, a2, a3;  // first halves of the four points
+    Vec4f b0, b1, b2, b3;  // second halves
+  };
+  auto write4 = [&](const BlockPoints& bp, const GroupAngles& ga, std::size_t s, const Vec4f& type) {
+    Four f{load4(&bp.x[s]), load4(&bp.y[s]), load4(&bp.z[s]), load4(&bp.intensity_f[s]),
+           load4(ga.time_s + s), load4(&bp.range[s]), load4(&ga.azimuth_ring[s]), type};
+    transpose4(f.a0, f.a1, f.a2, f.a3);
+    transpose4(f.b0, f.b1, f.b2, f.b3);
+    return f;
   };
 
   std::size_t n = 0;
@@ -315,19 +346,22 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
     group_angles(g, ga);
     BlockPoints p0;
     block_points(block0, ga, p0);
-    std::array<Vec4f, 4> first0;
-    std::array<Vec4f, 4> second0;
     // Every slot's point is written, in range or not, and kept (n advanced) only if in range: no branch on the data.
     // The room holds kMaxPointsPerPacket points, and n never runs ahead of the slots written.
     if constexpr (!kDual) {
       const auto w = std::bit_cast<float>(return_type_word(single_type));
       const Vec4f type = {w, w, w, w};
+      // Written out four times rather than as a loop over k: the eight halves stay in registers.
       for (std::size_t s = 0; s < kSlots; s += 4) {
-        write4(p0, ga, s, type, first0, second0);
-        for (std::size_t k = 0; k < 4; ++k) {
-          put_point(dst + n, first0[k], second0[k]);
-          n += static_cast<std::size_t>(p0.ok[s + k]);
-        }
+        const Four f = write4(p0, ga, s, type);
+        put_point(dst + n, f.a0, f.b0);
+        n += static_cast<std::size_t>(p0.ok[s]);
+        put_point(dst + n, f.a1, f.b1);
+        n += static_cast<std::size_t>(p0.ok[s + 1]);
+        put_point(dst + n, f.a2, f.b2);
+        n += static_cast<std::size_t>(p0.ok[s + 2]);
+        put_point(dst + n, f.a3, f.b3);
+        n += static_cast<std::size_t>(p0.ok[s + 3]);
       }
     } else {
       // Dual: the last return (block 0) and the strongest (block 1); one echo (both blocks equal) is emitted
@@ -343,17 +377,25 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
       }
       const auto w1 = std::bit_cast<float>(return_type_word(ReturnType::Strongest));
       const Vec4f type1 = {w1, w1, w1, w1};
-      std::array<Vec4f, 4> first1;
-      std::array<Vec4f, 4> second1;
       for (std::size_t s = 0; s < kSlots; s += 4) {
-        write4(p0, ga, s, load4(&type0[s]), first0, second0);
-        write4(p1, ga, s, type1, first1, second1);
-        for (std::size_t k = 0; k < 4; ++k) {
-          put_point(dst + n, first0[k], second0[k]);
-          n += static_cast<std::size_t>(p0.ok[s + k]);
-          put_point(dst + n, first1[k], second1[k]);
-          n += static_cast<std::size_t>(keep1[s + k]);
-        }
+        const Four f0 = write4(p0, ga, s, load4(&type0[s]));
+        const Four f1 = write4(p1, ga, s, type1);
+        put_point(dst + n, f0.a0, f0.b0);
+        n += static_cast<std::size_t>(p0.ok[s]);
+        put_point(dst + n, f1.a0, f1.b0);
+        n += static_cast<std::size_t>(keep1[s]);
+        put_point(dst + n, f0.a1, f0.b1);
+        n += static_cast<std::size_t>(p0.ok[s + 1]);
+        put_point(dst + n, f1.a1, f1.b1);
+        n += static_cast<std::size_t>(keep1[s + 1]);
+        put_point(dst + n, f0.a2, f0.b2);
+        n += static_cast<std::size_t>(p0.ok[s + 2]);
+        put_point(dst + n, f1.a2, f1.b2);
+        n += static_cast<std::size_t>(keep1[s + 2]);
+        put_point(dst + n, f0.a3, f0.b3);
+        n += static_cast<std::size_t>(p0.ok[s + 3]);
+        put_point(dst + n, f1.a3, f1.b3);
+        n += static_cast<std::size_t>(keep1[s + 3]);
       }
     }
   }
@@ -368,12 +410,16 @@ Expected<PacketHeader, DecodeError> Decoder::check(ByteSpan payload) const {
   return header;
 }
 
-std::size_t Decoder::decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room) const {
+std::size_t Decoder::decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room,
+                                   AzimuthRange* azimuths) const {
   const bool dual = header.return_mode == ReturnMode::Dual || header.dual_layout;
   const std::uint8_t* const bytes = payload.data();  // length checked by read_packet_header()
-  if (dual) return fast_wrap_ ? decode_points<true, true>(bytes, header, room)
-                              : decode_points<true, false>(bytes, header, room);
-  return fast_wrap_ ? decode_points<false, true>(bytes, header, room) : decode_points<false, false>(bytes, header, room);
+  if (dual) {
+    return fast_wrap_ ? decode_points<true, true>(bytes, header, room, azimuths)
+                      : decode_points<true, false>(bytes, header, room, azimuths);
+  }
+  return fast_wrap_ ? decode_points<false, true>(bytes, header, room, azimuths)
+                    : decode_points<false, false>(bytes, header, room, azimuths);
 }
 
 Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vector<LidarPoint>& out) const {
@@ -383,7 +429,7 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vecto
   // packet after packet to one vector does not reallocate per packet.
   const std::size_t base = out.size();
   out.resize(base + kMaxPointsPerPacket);
-  out.resize(base + decode_checked(payload, *header, out.data() + base));
+  out.resize(base + decode_checked(payload, *header, out.data() + base, nullptr));
   return header;
 }
 
@@ -392,7 +438,17 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<
   count = 0;
   auto header = check(payload);
   if (!header) return header;
-  count = decode_checked(payload, *header, room.data());
+  count = decode_checked(payload, *header, room.data(), nullptr);
+  return header;
+}
+
+Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
+                                                    std::size_t& count, AzimuthRange& azimuths) const {
+  count = 0;
+  azimuths = AzimuthRange{};
+  auto header = check(payload);
+  if (!header) return header;
+  count = decode_checked(payload, *header, room.data(), &azimuths);
   return header;
 }
 

@@ -45,6 +45,12 @@ inline std::uint16_t round_cdeg(std::int32_t i, float f) {
   const std::int32_t r = i + static_cast<std::int32_t>(f >= 0.5F);
   return static_cast<std::uint16_t>(r - kTurnCdeg * static_cast<std::int32_t>(r >= kTurnCdeg));
 }
+// round_cdeg() kept in 32 bits (the value is 0..35999 either way): a loop over slots of 32-bit lanes only, which
+// the compiler vectorises where the narrowing to 16 bits would keep it scalar.
+inline std::int32_t round_cdeg32(std::int32_t i, float f) {
+  const std::int32_t r = i + static_cast<std::int32_t>(f >= 0.5F);
+  return r - kTurnCdeg * static_cast<std::int32_t>(r >= kTurnCdeg);
+}
 
 // cos and sin of every whole 0.01 degree, with the step to the next entry, for linear interpolation: 36001 entries
 // of 16 bytes (563 KiB, of which a packet touches a few KiB), shared by every decoder, built once.
@@ -133,6 +139,17 @@ static_assert(offsetof(LidarPoint, x) == 0 && offsetof(LidarPoint, y) == 4 && of
 constexpr std::uint32_t azimuth_ring_word(std::uint16_t azimuth_cdeg, std::uint16_t ring) {
   if constexpr (std::endian::native == std::endian::little) return azimuth_cdeg | (std::uint32_t{ring} << 16);
   return (std::uint32_t{azimuth_cdeg} << 16) | ring;
+}
+// azimuth_ring_word(a, r) == (azimuth_word(a) | ring_word(r)) for every a, r: the two halves apart, so that the ring's
+// half is made once per slot and the azimuth's per firing in 32-bit lanes.
+constexpr std::uint32_t azimuth_word(std::int32_t azimuth_cdeg) {  // azimuth_cdeg in 0..65535
+  const auto a = static_cast<std::uint32_t>(azimuth_cdeg);
+  if constexpr (std::endian::native == std::endian::little) return a;
+  return a << 16;
+}
+constexpr std::uint32_t ring_word(std::uint16_t ring) {
+  if constexpr (std::endian::native == std::endian::little) return std::uint32_t{ring} << 16;
+  return ring;
 }
 constexpr std::uint32_t return_type_word(ReturnType type) {  // source = reserved1 = 0
   const auto t = static_cast<std::uint32_t>(type);

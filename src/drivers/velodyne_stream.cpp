@@ -40,8 +40,9 @@ void Stream::decode_one(ByteSpan payload, Stamp host_time, std::vector<LidarFram
   // Decoded straight into the frame under construction: no copy of the points, no initialisation of their room.
   const std::span<LidarPoint> room = assembler_.append_room(Decoder::kMaxPointsPerPacket);
   std::size_t count = 0;
-  const auto header =
-      decoder_->decode(payload, std::span<LidarPoint, Decoder::kMaxPointsPerPacket>(room.data(), room.size()), count);
+  AzimuthRange azimuths;
+  const auto header = decoder_->decode(
+      payload, std::span<LidarPoint, Decoder::kMaxPointsPerPacket>(room.data(), room.size()), count, azimuths);
   if (!header) {
     ++counters_.errors[static_cast<std::size_t>(header.error())];
     return;
@@ -50,7 +51,7 @@ void Stream::decode_one(ByteSpan payload, Stamp host_time, std::vector<LidarFram
   counters_.points += count;
   const Stamp sensor = sensor_time_from_hour_offset(header->timestamp_us, host_time);
   const std::size_t before = done.size();
-  assembler_.commit(count, sensor, host_time, done);
+  assembler_.commit(count, sensor, host_time, done, azimuths);
   count_frames(done, before);
 }
 

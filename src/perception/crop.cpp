@@ -109,6 +109,17 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
       in_box &= (abs(px) <= big) & (abs(py) <= big) & (abs(pz) <= big);
     }
     const unsigned bits = simd::mask_bits(in_box);
+    if (bits == 0xFU) {
+      // All four kept (most of a rotation near the tractor): their transposed coordinates are stored whole.
+      // x + k has room for four: k <= i and i + 4 <= n.
+      std::memcpy(x + k, &px, sizeof px);
+      std::memcpy(y + k, &py, sizeof py);
+      std::memcpy(z + k, &pz, sizeof pz);
+      for (std::size_t j = 0; j < 4; ++j) ring[k + j] = p[j].ring;
+      k += 4;
+      continue;
+    }
+    if (bits == 0U) continue;  // none kept: nothing to write (what lies at k and after is overwritten or trimmed)
     for (std::size_t j = 0; j < 4; ++j) {
       x[k] = p[j].x;
       y[k] = p[j].y;

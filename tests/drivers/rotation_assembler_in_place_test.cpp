@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 #include <string>
@@ -160,6 +161,90 @@ TEST(RotationAssemblerInPlace, RandomStreamsGiveTheReferenceFrames) {
     fast.finish(got);
     expect_same_frames(got, want, "run " + std::to_string(run));
     if (HasFatalFailure()) return;
+  }
+}
+
+// commit() with azimuth bounds: random walks as above, each packet committed with bounds that hold its azimuths
+// (tight, loose, or none at all), against the reference. Packets with an azimuth >= 36000 get bounds that say so.
+TEST(RotationAssemblerInPlace, AzimuthBoundsGiveTheReferenceFrames) {
+  std::mt19937 rng(11);
+  auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  std::size_t fast_packets = 0;
+  for (int run = 0; run < 40; ++run) {
+    const double cut = run % 4 == 0 ? 0.0 : uniform(0, 35999) / 100.0;
+    reference::RotationAssembler ref(cut);
+    RotationAssembler fast(cut);
+    std::vector<LidarFrame> want;
+    std::vector<LidarFrame> got;
+    int az = uniform(0, 35999);
+    std::int64_t t = 1'000'000'000'000;
+    for (int packet = 0; packet < 400; ++packet) {
+      // Mostly packets as a sensor gives them (a small forward sweep), some of random walks with jumps.
+      const bool sweep = uniform(0, 9) != 0;
+      std::vector<LidarPoint> pts(static_cast<std::size_t>(uniform(0, 40)));
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const int kind = sweep ? uniform(0, 79) : uniform(0, 99);
+        az += kind < 80 ? uniform(0, 60) : kind < 90 ? -uniform(0, 1200) : kind < 97 ? uniform(0, 36000) : 0;
+        az = ((az % 36000) + 36000) % 36000;
+        pts[i].azimuth_cdeg = static_cast<std::uint16_t>(kind == 99 ? uniform(36000, 65535) : az);
+        pts[i].time_s = static_cast<float>(i) * 1.152e-6F - 5e-4F;
+        pts[i].x = static_cast<float>(packet);
+      }
+      AzimuthRange bounds;
+      if (!pts.empty() && uniform(0, 9) != 0) {
+        int lo = 65535;
+        int hi = 0;
+        for (const auto& p : pts) {
+          lo = std::min<int>(lo, p.azimuth_cdeg);
+          hi = std::max<int>(hi, p.azimuth_cdeg);
+        }
+        if (uniform(0, 1) == 0) {  // loose
+          lo = std::max(0, lo - uniform(0, 3000));
+          hi = std::min(65535, hi + uniform(0, 3000));
+        }
+        bounds = AzimuthRange{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
+      }
+      t += uniform(0, 2'000'000);
+      ref.push(pts, Stamp{t}, Stamp{t + 700}, want);
+      const std::span<LidarPoint> room = fast.append_room(pts.size());
+      std::copy(pts.begin(), pts.end(), room.begin());
+      fast.commit(pts.size(), Stamp{t}, Stamp{t + 700}, got, bounds);
+      if (packet == 200) {  // end of a stream and start of another in the same assembler
+        ref.finish(want);
+        fast.finish(got);
+      }
+      if (bounds.max_cdeg < 36000 && !pts.empty()) ++fast_packets;
+    }
+    ref.finish(want);
+    fast.finish(got);
+    expect_same_frames(got, want, "run " + std::to_string(run));
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(fast_packets, 40U * 400U / 2);
+}
+
+// Bounds that are no information (the default, or min > max) are safe: the per-point path.
+TEST(RotationAssemblerInPlace, UninformativeAzimuthBoundsAreSafe) {
+  for (const AzimuthRange bounds : {AzimuthRange{}, AzimuthRange{500, 100}, AzimuthRange{0, 36000}}) {
+    reference::RotationAssembler ref(0.0);
+    RotationAssembler fast(0.0);
+    std::vector<LidarFrame> want;
+    std::vector<LidarFrame> got;
+    for (int k = 0; k < 250; ++k) {
+      std::vector<LidarPoint> pts(32);
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        pts[i].azimuth_cdeg = static_cast<std::uint16_t>((k * 360 + static_cast<int>(i) * 11) % 36000);
+        pts[i].time_s = static_cast<float>(i) * 1e-6F;
+      }
+      ref.push(pts, Stamp{k * 1000}, Stamp{k * 1000}, want);
+      const std::span<LidarPoint> room = fast.append_room(pts.size());
+      std::copy(pts.begin(), pts.end(), room.begin());
+      fast.commit(pts.size(), Stamp{k * 1000}, Stamp{k * 1000}, got, bounds);
+    }
+    ref.finish(want);
+    fast.finish(got);
+    ASSERT_GE(want.size(), 2U);
+    expect_same_frames(got, want, "bounds " + std::to_string(bounds.min_cdeg) + ".." + std::to_string(bounds.max_cdeg));
   }
 }
 

@@ -32,6 +32,8 @@ struct Diff {
   std::size_t points = 0;
   double max_xy_m = 0.0;        // largest |(x, y) fast - (x, y) reference|
   double max_xy_ratio = 0.0;    // ... relative to xy_tolerance()
+  std::size_t packets = 0;      // decoded without an error
+  std::size_t bounded = 0;      // ... of them with azimuth bounds narrower than every azimuth (AzimuthRange)
 };
 
 // Everything but x and y bit for bit; x and y within xy_tolerance().
@@ -81,6 +83,13 @@ void compare_packets(const std::vector<std::vector<std::uint8_t>>& packets, cons
       EXPECT_TRUE(a.empty());
       EXPECT_EQ(count, 0U);
       EXPECT_EQ(h.error(), h2.error());
+      AzimuthRange bounds{123, 45};
+      count = 999;
+      const auto h3 = fast.decode(packets[k], std::span<LidarPoint, Decoder::kMaxPointsPerPacket>(room), count, bounds);
+      ASSERT_FALSE(h3.has_value()) << what;
+      EXPECT_EQ(count, 0U);
+      EXPECT_EQ(bounds.min_cdeg, 0);  // an error leaves no bounds: every azimuth
+      EXPECT_EQ(bounds.max_cdeg, 0xFFFF);
       continue;
     }
     ASSERT_EQ(count, a.size()) << what << " packet " << k;
@@ -88,6 +97,26 @@ void compare_packets(const std::vector<std::vector<std::uint8_t>>& packets, cons
                           count * sizeof(LidarPoint)),
               0)
         << what << " packet " << k << ": the two decode() overloads differ";
+    // The overload that also gives azimuth bounds: the same points, each azimuth inside the bounds.
+    std::memset(static_cast<void*>(room.data()), 0x3C, room.size() * sizeof(LidarPoint));
+    AzimuthRange bounds{123, 45};
+    const auto h3 = fast.decode(packets[k], std::span<LidarPoint, Decoder::kMaxPointsPerPacket>(room), count, bounds);
+    ASSERT_TRUE(h3.has_value()) << what;
+    ASSERT_EQ(count, a.size()) << what << " packet " << k;
+    ASSERT_EQ(std::memcmp(static_cast<const void*>(room.data()), static_cast<const void*>(a.data()),
+                          count * sizeof(LidarPoint)),
+              0)
+        << what << " packet " << k << ": decode() with azimuth bounds differs";
+    ASSERT_LE(bounds.min_cdeg, bounds.max_cdeg) << what << " packet " << k;
+    for (std::size_t i = 0; i < count; ++i) {
+      ASSERT_GE(a[i].azimuth_cdeg, bounds.min_cdeg) << what << " packet " << k << " point " << i;
+      ASSERT_LE(a[i].azimuth_cdeg, bounds.max_cdeg) << what << " packet " << k << " point " << i;
+    }
+    ++diff.packets;
+    if (bounds.min_cdeg > 0 || bounds.max_cdeg < 0xFFFF) {
+      ++diff.bounded;
+      EXPECT_LT(bounds.max_cdeg, 36000) << what << " packet " << k;
+    }
     ref.decode(packets[k], *h, b);
     expect_same_points(a, b, diff, what + " packet " + std::to_string(k));
     if (testing::Test::HasFatalFailure()) return;
@@ -150,6 +179,35 @@ TEST(VelodyneDecoderFast, RealCapturesMatchTheReferenceDecoder) {
             << diff.max_xy_m * 1000.0 << " mm (" << diff.max_xy_ratio * 100.0 << " % of the tolerance)\n";
   RecordProperty("max_xy_difference_mm", std::to_string(diff.max_xy_m * 1000.0));
   EXPECT_GT(diff.points, 1'000'000U);
+  // Bounds for all but the packets whose firings wrap past 0 (about one per rotation) and those decoded with
+  // corrections beyond 350 degrees (a third of the runs): RotationAssembler::commit() relies on them for speed.
+  std::cout << "[azimuth bounds, real captures] " << diff.bounded << " of " << diff.packets << " packets bounded\n";
+  EXPECT_GT(diff.bounded, diff.packets * 6 / 10);
+}
+
+// A calibration whose azimuth corrections (up to 160 degrees) wrap many firings past 0, still on the decoder's
+// fast wrapping path (under 350 degrees).
+Calibration large_rotations(Model m) {
+  Calibration cal = corrected(m);
+  for (std::size_t i = 0; i < cal.lasers.size(); ++i) {
+    cal.lasers[i].rot_deg = (i % 2 == 0 ? -1.0 : 1.0) * 40.0 * static_cast<double>(i % 5);
+  }
+  return cal;
+}
+
+// Azimuth bounds where corrections make firings wrap: bounded only where no firing wraps, and then right.
+TEST(VelodyneDecoderFast, AzimuthBoundsHoldEveryPointWithLargeCorrections) {
+  Diff diff;
+  for (const char* file : {"hdl32e_monterey_600.pcap", "vlp16_veloview_300.pcap"}) {
+    const Model m = std::string(file).starts_with("vlp16") ? Model::VLP16 : Model::HDL32E;
+    DecoderOptions o;
+    o.model = m;
+    compare_packets(capture(file), large_rotations(m), o, diff, std::string(file) + " large rotations");
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(diff.packets, 500U);
+  EXPECT_GT(diff.bounded, 0U);
+  EXPECT_LT(diff.bounded, diff.packets);
 }
 
 // Random packets: every return mode and layout, azimuth steps across 0 and corrupted ones, ranges at and beyond

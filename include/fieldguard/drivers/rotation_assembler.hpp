@@ -3,12 +3,21 @@
 // One producer: not thread-safe. Push-style: frames come out as they complete.
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
 
 namespace fieldguard {
+
+// Bounds on the azimuth_cdeg of a run of points (every one of them in [min_cdeg, max_cdeg]; not necessarily
+// attained). A decoder knows them per packet from the block azimuths and its calibration; the rotation assembler
+// uses them to pass over a packet that cannot hold the cut angle without looking at each point's azimuth.
+struct AzimuthRange {
+  std::uint16_t min_cdeg = 0;
+  std::uint16_t max_cdeg = 0xFFFF;  // the default holds every azimuth: no information
+};
 
 class RotationAssembler {
  public:
@@ -27,6 +36,13 @@ class RotationAssembler {
   // call of any other non-const member; room not committed is not part of any frame.
   [[nodiscard]] std::span<LidarPoint> append_room(std::size_t n);
   void commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time, std::vector<LidarFrame>& done);
+  // The same, given bounds on the azimuths of the `count` points (a decoder's, velodyne::Decoder::decode()): where
+  // they show that no point of the packet can end the frame or step back across the cut angle (a frame is under
+  // way, and the packet's azimuths and the last one before it lie within half a turn, on one side of the cut), the
+  // points' azimuths are not looked at one by one. Gives exactly what commit() without them gives, as long as
+  // every point's azimuth lies inside the bounds; AzimuthRange{} (every azimuth) is always safe.
+  void commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time, std::vector<LidarFrame>& done,
+              AzimuthRange azimuths);
 
   // End of stream: emits what is pending as a partial frame (if it holds any point).
   void finish(std::vector<LidarFrame>& done);
@@ -40,6 +56,9 @@ class RotationAssembler {
  private:
   void emit(std::vector<LidarFrame>& done, bool partial, std::vector<LidarPoint>&& next_points);
   [[nodiscard]] std::vector<LidarPoint> fresh_buffer();
+  // commit() of a packet that, by its azimuth bounds, neither ends the frame nor starts one; false (nothing done)
+  // where the bounds do not show that.
+  [[nodiscard]] bool commit_within_frame(std::size_t count, Stamp packet_sensor_time, AzimuthRange azimuths);
 
   std::uint16_t cut_cdeg_;
   // The frame under construction. Its points vector is kept larger than the frame (room for the next packets,

@@ -12,6 +12,7 @@
 #include "fieldguard/core/bytes.hpp"
 #include "fieldguard/core/expected.hpp"
 #include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/drivers/rotation_assembler.hpp"
 #include "fieldguard/drivers/velodyne_calibration.hpp"
 #include "fieldguard/drivers/velodyne_types.hpp"
 
@@ -60,14 +61,21 @@ class Decoder {
   // RotationAssembler::append_room() / commit().
   Expected<PacketHeader, DecodeError> decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
                                              std::size_t& count) const;
+  // The same, and `azimuths` set to bounds on the azimuth_cdeg of every point written (for
+  // RotationAssembler::commit()); on an error, or where the firings' azimuths wrap past 0 inside the packet, the
+  // bounds are AzimuthRange{} (every azimuth).
+  Expected<PacketHeader, DecodeError> decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
+                                             std::size_t& count, AzimuthRange& azimuths) const;
 
   [[nodiscard]] Model model() const { return options_.model; }
 
  private:
   [[nodiscard]] Expected<PacketHeader, DecodeError> check(ByteSpan payload) const;
-  [[nodiscard]] std::size_t decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room) const;
+  [[nodiscard]] std::size_t decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room,
+                                           AzimuthRange* azimuths) const;
   template <bool kDual, bool kFastWrap>
-  [[nodiscard]] std::size_t decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst) const;
+  [[nodiscard]] std::size_t decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst,
+                                          AzimuthRange* azimuths) const;
 
   DecoderOptions options_;
   Calibration calibration_;
@@ -84,6 +92,7 @@ class Decoder {
     std::array<float, kSlotsPerBlock> in_block_us;     // firing time after the block's first firing
     std::array<float, kSlotsPerBlock> block_fraction;  // in_block_us / block duration: share of the azimuth step
     std::array<std::uint16_t, kSlotsPerBlock> ring;
+    std::array<std::uint32_t, kSlotsPerBlock> ring_word;  // the ring's half of a point's (azimuth, ring) word
   };
   SlotTables slots_{};
   // Time of each firing of a packet (s), relative to the firing the packet timestamp marks: [0] single return
@@ -96,6 +105,10 @@ class Decoder {
   // Every |rot_cdeg| < 35000: an azimuth + step - correction stays inside (-36000, 72000), where one add or
   // subtract of a turn wraps it exactly as fmod does.
   bool fast_wrap_ = true;
+  // Smallest and largest azimuth correction of the slots (0.01 degree): with the block azimuths they bound the
+  // azimuth of every firing of a packet (AzimuthRange).
+  float min_rot_cdeg_ = 0.F;
+  float max_rot_cdeg_ = 0.F;
 };
 
 // Decides HDL-32E vs VLP-16 from the stream: the factory byte AND the packet spacing / firing layout,
