@@ -49,6 +49,7 @@
 #include "fieldguard/app/config.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/perception/cluster_absorb.hpp"
+#include "fieldguard/perception/cluster_join.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/near_field.hpp"
@@ -456,6 +457,33 @@ void BM_PipelinePublished(benchmark::State& state) { pipeline_bench(state, "PIPE
 void BM_PipelineFieldguard(benchmark::State& state) {
   pipeline_bench(state, "PIPELINE fieldguard.yaml", fieldguard_params());
 }
+// The floating-cluster joins (cluster_join.hpp; no PCL counterpart) with fieldguard.yaml's keys, on its clusters
+// after absorption. Heights above a level ground at the sensor's mounting height: the stage's cost is its pairs of
+// clusters, whatever the heights make of them.
+void BM_ClusterJoin(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const ClusterParams& cp = fieldguard_params().cluster;
+  EuclideanClusterer clusterer(cp);
+  ClusterAbsorber absorber(cp.absorb_max_points, cp.absorb_margin_m);
+  Clusters clustered, work;
+  clusterer.extract(f.above, clustered);
+  absorber.absorb(f.above, clustered);
+  const auto sensor_h = static_cast<float>(fieldguard_params().ground.zones.sensor_height_m);
+  std::vector<float> height(f.above.z.begin(), f.above.z.end());
+  for (float& h : height) h += sensor_h;
+  ClusterJoiner joiner(ClusterJoinParams::from(cp));
+  std::uint32_t joined = 0;
+  paired(state, "cluster join (floating)", static_cast<int>(state.range(0)), f.above.size(),
+         [&] {
+           work = clustered;  // the stage rewrites its input: timed with this copy
+           joined = joiner.join(f.above, height, fieldguard_params().filters, work);
+           benchmark::DoNotOptimize(work.indices.data());
+         },
+         {});
+  state.counters["clusters_in"] = static_cast<double>(clustered.size());
+  state.counters["joins"] = static_cast<double>(joined);
+}
+
 // fieldguard.yaml's pipeline without the crop-canopy rule (canopy.hpp) and the radial ground blend
 // (ZoneParams::blend_radial): their cost is BM_PipelineFieldguard's time minus this one's.
 void BM_PipelineFieldguardNoCanopy(benchmark::State& state) {
@@ -466,6 +494,17 @@ void BM_PipelineFieldguardNoCanopy(benchmark::State& state) {
     return q;
   }();
   pipeline_bench(state, "PIPELINE fieldguard.yaml without canopy rule, ground blend", p);
+}
+
+// fieldguard.yaml's pipeline without the canopy rule's look at a low cluster's surroundings
+// (FilterParams::canopy_surroundings_m): its cost is BM_PipelineFieldguard's time minus this one's.
+void BM_PipelineFieldguardNoSurroundings(benchmark::State& state) {
+  static const PipelineParams p = [] {
+    PipelineParams q = fieldguard_params();
+    q.filters.canopy_surroundings_m = 0.0;
+    return q;
+  }();
+  pipeline_bench(state, "PIPELINE fieldguard.yaml without canopy surroundings", p);
 }
 
 // Packets to obstacles: the UDP payloads of the rotation into velodyne::Stream, the rotation it emits through
@@ -610,9 +649,11 @@ FG_BENCH(BM_ClusterFixedGrid);
 FG_BENCH(BM_ClusterAdaptiveGrid);
 FG_BENCH(BM_ClusterAnisotropicGrid);
 FG_BENCH(BM_ClusterAbsorb);
+FG_BENCH(BM_ClusterJoin);
 FG_BENCH(BM_PipelinePublished);
 FG_BENCH(BM_PipelineFieldguard);
 FG_BENCH(BM_PipelineFieldguardNoCanopy);
+FG_BENCH(BM_PipelineFieldguardNoSurroundings);
 FG_BENCH(BM_Decode);
 FG_BENCH(BM_PacketsToObstacles);
 FG_BENCH(BM_NearField);
@@ -653,3 +694,4 @@ int main(int argc, char** argv) {
   print_summary();
   return 0;
 }
+

@@ -236,7 +236,8 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   const std::string path = "perception.cluster";
   if (!r.section(c, path,
                  {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m",
-                  "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m"})) {
+                  "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m",
+                  "join_float_height_m", "join_gap_m", "join_stacked", "join_stack_margin_m"})) {
     return;
   }
   if (auto m = r.choice(c, path, "method", {"fixed", "adaptive", "anisotropic"})) {
@@ -255,6 +256,10 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   r.number(c, path, "horizontal_max_tolerance_m", p.horizontal_max_tolerance_m, 0.01, 10.0, "m");
   r.integer(c, path, "absorb_max_points", p.absorb_max_points, 0, 1000000);
   r.number(c, path, "absorb_margin_m", p.absorb_margin_m, 0.0, 10.0, "m");
+  r.number(c, path, "join_float_height_m", p.join_float_height_m, 0.0, 10.0, "m");
+  r.number(c, path, "join_gap_m", p.join_gap_m, 0.0, 10.0, "m");
+  if (auto j = r.choice(c, path, "join_stacked", {"false", "true"})) p.join_stacked = *j == 1;
+  r.number(c, path, "join_stack_margin_m", p.join_stack_margin_m, 0.0, 10.0, "m");
   // A radius that grows with range: from tolerance_m up to its cap, by factor * tan(beam_spacing) per metre.
   const auto check_growth = [&](const char* cap_key, double cap, const char* factor_key, double factor,
                                 const char* which) {
@@ -282,7 +287,9 @@ void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& 
   if (!r.section(f, fp,
                  {"min_points", "max_points", "min_volume_m3", "max_volume_m3", "min_height_m",
                   "min_points_full_range_m", "min_points_floor", "canopy_max_height_m", "canopy_min_jitter_m",
-                  "canopy_min_triples", "canopy_max_gap_m", "canopy_needle_depth_m", "canopy_needle_ratio"})) {
+                  "canopy_min_triples", "canopy_max_gap_m", "canopy_needle_depth_m", "canopy_needle_ratio",
+                  "float_min_height_m", "float_min_points", "canopy_surroundings_m", "min_height_growth_from_m",
+                  "min_height_growth_per_m", "min_height_growth_max_m"})) {
     return;
   }
   r.integer(f, fp, "min_points", p.min_points, 1, 10000000);
@@ -290,6 +297,9 @@ void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& 
   r.number(f, fp, "min_volume_m3", p.min_volume_m3, 0.0, 1e6, "m^3");
   r.number(f, fp, "max_volume_m3", p.max_volume_m3, 0.0, 1e6, "m^3");
   r.number(f, fp, "min_height_m", p.min_height_m, 0.0, 10.0, "m");
+  r.number(f, fp, "min_height_growth_from_m", p.min_height_growth_from_m, 0.0, 500.0, "m");
+  r.number(f, fp, "min_height_growth_per_m", p.min_height_growth_per_m, 0.0, 1.0, "m/m");
+  r.number(f, fp, "min_height_growth_max_m", p.min_height_growth_max_m, 0.0, 10.0, "m");
   r.number(f, fp, "min_points_full_range_m", p.min_points_full_range_m, 0.0, 500.0, "m");
   r.integer(f, fp, "min_points_floor", p.min_points_floor, 1, 10000000);
   r.number(f, fp, "canopy_max_height_m", p.canopy_max_height_m, 0.0, 3.0, "m");
@@ -298,12 +308,20 @@ void read_filters(YamlReader& r, const YAML::Node& f, perception::FilterParams& 
   r.number(f, fp, "canopy_max_gap_m", p.canopy_max_gap_m, 0.05, 5.0, "m");
   r.number(f, fp, "canopy_needle_depth_m", p.canopy_needle_depth_m, 0.0, 10.0, "m");
   r.number(f, fp, "canopy_needle_ratio", p.canopy_needle_ratio, 1.0, 100.0, "");
+  r.number(f, fp, "canopy_surroundings_m", p.canopy_surroundings_m, 0.0, 10.0, "m");
+  r.number(f, fp, "float_min_height_m", p.float_min_height_m, 0.0, 10.0, "m");
+  r.integer(f, fp, "float_min_points", p.float_min_points, 1, 10000000);
   if (p.max_points > 0 && p.min_points > p.max_points) {
     r.issue(value_or(f, "max_points"), fp + ".max_points", "must not be less than min_points (0 = no upper limit)");
   }
   if (p.max_volume_m3 > 0.0 && p.min_volume_m3 > p.max_volume_m3) {
     r.issue(value_or(f, "max_volume_m3"), fp + ".max_volume_m3",
             "must not be less than min_volume_m3 (0 = no upper limit)");
+  }
+  // A cap below min_height_m would lower the threshold far out instead of raising it.
+  if (p.min_height_growth_max_m > 0.0 && p.min_height_growth_max_m < p.min_height_m) {
+    r.issue(value_or(f, "min_height_growth_max_m"), fp + ".min_height_growth_max_m",
+            "must not be less than min_height_m (0 = no cap)");
   }
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <stdexcept>
 
 namespace fieldguard::perception {
@@ -68,6 +69,30 @@ RingJitter RingJitterMeter::measure(const Cloud& cloud, std::span<const std::uin
   std::nth_element(offs_.begin(), mid, offs_.end());
   out.median_m = *mid;
   return out;
+}
+
+RingJitter RingJitterMeter::measure_all(const Cloud& cloud) {
+  all_.resize(cloud.size());
+  std::iota(all_.begin(), all_.end(), 0U);
+  return measure(cloud, all_);
+}
+
+void gather_low_surroundings(const Cloud& cluster_cloud, std::span<const std::uint32_t> members, const Cloud& cloud,
+                             std::span<const float> height_m, std::span<const std::uint8_t> skip,
+                             const LowSurroundings& around, Cloud& out) {
+  if (height_m.size() != cloud.size() || (!skip.empty() && skip.size() != cloud.size())) {
+    throw std::invalid_argument("gather_low_surroundings: heights and marks need one value per point");
+  }
+  out.clear();
+  for (const std::uint32_t i : members) out.push_back(cluster_cloud.x[i], cluster_cloud.y[i], cluster_cloud.z[i]);
+  const float x0 = around.min[0] - around.radius_m, x1 = around.max[0] + around.radius_m;
+  const float y0 = around.min[1] - around.radius_m, y1 = around.max[1] + around.radius_m;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const float x = cloud.x[i], y = cloud.y[i];
+    if (x < x0 || x > x1 || y < y0 || y > y1 || !(height_m[i] < around.max_height_m)) continue;
+    if (!skip.empty() && skip[i] != 0U) continue;
+    out.push_back(x, y, cloud.z[i]);
+  }
 }
 
 }  // namespace fieldguard::perception

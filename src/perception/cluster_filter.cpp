@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace fieldguard::perception {
 
@@ -25,7 +26,7 @@ ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m, st
   if (indices.empty()) return s;
   constexpr float kBig = std::numeric_limits<float>::max();
   float lo[3] = {kBig, kBig, kBig}, hi[3] = {-kBig, -kBig, -kBig};
-  float r2 = kBig, top = -kBig;
+  float r2 = kBig, top = -kBig, bottom = kBig;
   bool all_guessed = !guessed.empty();
   for (const std::uint32_t i : indices) {
     all_guessed = all_guessed && guessed[i] != 0U;
@@ -38,12 +39,14 @@ ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m, st
     hi[2] = std::max(hi[2], z);
     r2 = std::min(r2, x * x + y * y);
     top = std::max(top, height_m[i]);
+    bottom = std::min(bottom, height_m[i]);
   }
   s.points = static_cast<std::uint32_t>(indices.size());
   s.min = {lo[0], lo[1], lo[2]};
   s.max = {hi[0], hi[1], hi[2]};
   s.distance_m = std::sqrt(r2);
   s.height_above_ground_m = top;
+  s.lowest_above_ground_m = bottom;
   s.ground_guessed = all_guessed;
   return s;
 }
@@ -62,13 +65,30 @@ std::uint32_t min_points_at(const FilterParams& f, float distance_m) {
   return std::min(full, std::max(floor, scaled));
 }
 
+std::uint32_t min_points_of(const FilterParams& f, const ClusterSummary& s) {
+  const std::uint32_t need = min_points_at(f, s.distance_m);
+  if (!(f.float_min_height_m > 0.0) || !(static_cast<double>(s.lowest_above_ground_m) >= f.float_min_height_m)) {
+    return need;
+  }
+  return std::min(need, static_cast<std::uint32_t>(std::max(f.float_min_points, 1)));
+}
+
+double min_height_at(const FilterParams& f, float distance_m) {
+  const double d = static_cast<double>(distance_m);
+  if (!(f.min_height_growth_from_m > 0.0) || !(d > f.min_height_growth_from_m)) return f.min_height_m;
+  const double grown = f.min_height_m + f.min_height_growth_per_m * (d - f.min_height_growth_from_m);
+  return f.min_height_growth_max_m > 0.0 ? std::max(f.min_height_m, std::min(grown, f.min_height_growth_max_m)) : grown;
+}
+
 Rejection check_cluster(const FilterParams& f, const ClusterSummary& s) {
-  if (s.points < min_points_at(f, s.distance_m)) return Rejection::TooFewPoints;
+  if (s.points < min_points_of(f, s)) return Rejection::TooFewPoints;
   if (f.max_points > 0 && s.points > static_cast<std::uint32_t>(f.max_points)) return Rejection::TooManyPoints;
   const double v = static_cast<double>(s.volume_m3());
   if (v < f.min_volume_m3) return Rejection::TooSmall;
   if (f.max_volume_m3 > 0.0 && v > f.max_volume_m3) return Rejection::TooLarge;
-  if (f.min_height_m > 0.0 && static_cast<double>(s.height_above_ground_m) < f.min_height_m) return Rejection::TooLow;
+  if (f.min_height_m > 0.0 && static_cast<double>(s.height_above_ground_m) < min_height_at(f, s.distance_m)) {
+    return Rejection::TooLow;
+  }
   return Rejection::Kept;
 }
 
@@ -86,6 +106,33 @@ Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Clo
     return Rejection::Porous;
   }
   if (j.triples < static_cast<std::uint32_t>(std::max(f.canopy_min_triples, 1))) return Rejection::Kept;
+  return static_cast<double>(j.median_m) >= f.canopy_min_jitter_m ? Rejection::Porous : Rejection::Kept;
+}
+
+Rejection check_canopy_surroundings(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
+                                    std::span<const std::uint32_t> indices, const FrameSurroundings& frame,
+                                    Cloud& scratch, RingJitterMeter& meter) {
+  if (!(f.canopy_surroundings_m > 0.0) || !(f.canopy_max_height_m > 0.0) ||
+      static_cast<double>(s.height_above_ground_m) > f.canopy_max_height_m) {
+    return Rejection::Kept;
+  }
+  const auto min_triples = static_cast<std::uint32_t>(std::max(f.canopy_min_triples, 1));
+  // Enough triples of its own: check_canopy has told already, and its surroundings do not overrule it (a solid
+  // box standing in a crop stays a box).
+  if (meter.measure(cloud, indices).triples >= min_triples) return Rejection::Kept;
+  if (frame.marks.size() != frame.cloud.size() || frame.height_m.size() != frame.cloud.size()) {
+    throw std::invalid_argument("check_canopy_surroundings: one mark and one height per point of the frame");
+  }
+  for (const std::uint32_t i : indices) frame.marks[frame.in_cloud[i]] = 1U;
+  LowSurroundings around;
+  around.min = {s.min[0], s.min[1]};
+  around.max = {s.max[0], s.max[1]};
+  around.radius_m = static_cast<float>(f.canopy_surroundings_m);
+  around.max_height_m = static_cast<float>(f.min_height_m);
+  gather_low_surroundings(cloud, indices, frame.cloud, frame.height_m, frame.marks, around, scratch);
+  for (const std::uint32_t i : indices) frame.marks[frame.in_cloud[i]] = 0U;
+  const RingJitter j = meter.measure_all(scratch);
+  if (j.triples < min_triples) return Rejection::Kept;
   return static_cast<double>(j.median_m) >= f.canopy_min_jitter_m ? Rejection::Porous : Rejection::Kept;
 }
 

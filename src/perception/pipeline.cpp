@@ -9,6 +9,7 @@
 
 #include "fieldguard/perception/cluster_absorb.hpp"
 #include "fieldguard/perception/cluster_filter.hpp"
+#include "fieldguard/perception/cluster_join.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/near_field.hpp"
@@ -25,6 +26,7 @@ struct Pipeline::Impl {
         voxel(p.voxel),
         clusterer(p.cluster),
         absorber(p.cluster.absorb_max_points, p.cluster.absorb_margin_m),
+        joiner(ClusterJoinParams::from(p.cluster)),
         near(p.near_field),
         jitter(p.cluster.beam_spacing_deg, p.filters.canopy_max_gap_m) {
     if (p.roi.min[0] >= p.roi.max[0] || p.roi.min[1] >= p.roi.max[1] || p.roi.min[2] >= p.roi.max[2]) {
@@ -43,8 +45,11 @@ struct Pipeline::Impl {
   std::optional<ZoneGround> zones;
   EuclideanClusterer clusterer;
   ClusterAbsorber absorber;
+  ClusterJoiner joiner;
   NearField near;
   RingJitterMeter jitter;
+  Cloud surroundings;                   // check_canopy_surroundings' scratch
+  Buffer<std::uint8_t> surround_marks;  // ... and its marks, one per voxel, left zero
 
   Cloud cropped, voxels, above;
   GroundLabels ground;
@@ -125,6 +130,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
 
   m.clusterer.extract(m.above, m.clusters);
   m.absorber.absorb(m.above, m.clusters);
+  m.joiner.join(m.above, m.above_height, m.params.filters, m.clusters);
 
   const FilterParams& f = m.params.filters;
   for (std::size_t c = 0; c < m.clusters.size(); ++c) {
@@ -148,6 +154,11 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
       why = check_cluster(f, s);
     }
     if (why == Rejection::Kept) why = check_canopy(f, s, m.above, members, m.jitter);
+    if (why == Rejection::Kept && f.canopy_surroundings_m > 0.0) {
+      if (m.surround_marks.size() != n) m.surround_marks.assign(n, 0U);
+      const FrameSurroundings frame{m.voxels, m.ground.height_m, m.above_index, m.surround_marks};
+      why = check_canopy_surroundings(f, s, m.above, members, frame, m.surroundings, m.jitter);
+    }
     // Too few points for its distance: not a cluster at all (PCL's minimum cluster size), left unclustered.
     if (why == Rejection::TooFewPoints) continue;
     ++result.counts.clusters;

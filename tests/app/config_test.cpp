@@ -123,6 +123,10 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.cluster.horizontal_max_tolerance_m, d.cluster.horizontal_max_tolerance_m);
   EXPECT_EQ(p.cluster.absorb_max_points, d.cluster.absorb_max_points);
   EXPECT_EQ(p.cluster.absorb_margin_m, d.cluster.absorb_margin_m);
+  EXPECT_EQ(p.cluster.join_float_height_m, d.cluster.join_float_height_m);
+  EXPECT_EQ(p.cluster.join_gap_m, d.cluster.join_gap_m);
+  EXPECT_EQ(p.cluster.join_stacked, d.cluster.join_stacked);
+  EXPECT_EQ(p.cluster.join_stack_margin_m, d.cluster.join_stack_margin_m);
   EXPECT_EQ(p.filters.min_points, d.filters.min_points);
   EXPECT_EQ(p.filters.max_points, d.filters.max_points);
   EXPECT_EQ(p.filters.min_volume_m3, d.filters.min_volume_m3);
@@ -130,6 +134,18 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.filters.min_height_m, d.filters.min_height_m);
   EXPECT_EQ(p.filters.min_points_full_range_m, d.filters.min_points_full_range_m);
   EXPECT_EQ(p.filters.min_points_floor, d.filters.min_points_floor);
+  EXPECT_EQ(p.filters.min_height_growth_from_m, d.filters.min_height_growth_from_m);
+  EXPECT_EQ(p.filters.min_height_growth_per_m, d.filters.min_height_growth_per_m);
+  EXPECT_EQ(p.filters.min_height_growth_max_m, d.filters.min_height_growth_max_m);
+  EXPECT_EQ(p.filters.float_min_height_m, d.filters.float_min_height_m);
+  EXPECT_EQ(p.filters.float_min_points, d.filters.float_min_points);
+  EXPECT_EQ(p.filters.canopy_max_height_m, d.filters.canopy_max_height_m);
+  EXPECT_EQ(p.filters.canopy_min_jitter_m, d.filters.canopy_min_jitter_m);
+  EXPECT_EQ(p.filters.canopy_min_triples, d.filters.canopy_min_triples);
+  EXPECT_EQ(p.filters.canopy_max_gap_m, d.filters.canopy_max_gap_m);
+  EXPECT_EQ(p.filters.canopy_needle_depth_m, d.filters.canopy_needle_depth_m);
+  EXPECT_EQ(p.filters.canopy_needle_ratio, d.filters.canopy_needle_ratio);
+  EXPECT_EQ(p.filters.canopy_surroundings_m, d.filters.canopy_surroundings_m);
   EXPECT_EQ(p.near_field.enabled, d.near_field.enabled);
   EXPECT_EQ(p.near_field.zone.min, d.near_field.zone.min);
   EXPECT_EQ(p.near_field.zone.max, d.near_field.zone.max);
@@ -374,6 +390,8 @@ INSTANTIATE_TEST_SUITE_P(
                 "out of range"},
         BadCase{"full_range_negative", "perception: {filters: {min_points_full_range_m: -3}}\n",
                 "perception.filters.min_points_full_range_m", "out of range"},
+        BadCase{"surroundings_negative", "perception: {filters: {canopy_surroundings_m: -1}}\n",
+                "perception.filters.canopy_surroundings_m", "out of range"},
         BadCase{"ransac_iter", "perception: {ground: {ransac: {iterations: 0}}}\n",
                 "perception.ground.ransac.iterations", "out of range"},
         BadCase{"missing_calibration", "lidar: {calibration_file: /nonexistent/cal.xml}\n", "lidar.calibration_file",
@@ -392,6 +410,17 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"near_key", "perception: {near_field: {max_gap: 0.3}}\n", "perception.near_field.max_gap",
                 "unknown key"}),
     [](const ::testing::TestParamInfo<BadCase>& p) { return std::string(p.param.name); });
+
+TEST(ConfigLoad, ReadsCanopySurroundingsAndDefaultsToFieldguards) {
+  const auto d = load_config_text("perception: {filters: {min_points: 6}}\n", "t.yaml");
+  EXPECT_EQ(d.config.perception.filters.canopy_surroundings_m, 3.0);
+  const auto r = load_config_text("perception: {filters: {canopy_surroundings_m: 1.5}}\n", "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  EXPECT_EQ(r.config.perception.filters.canopy_surroundings_m, 1.5);
+  const auto off = load_config_text("perception: {filters: {canopy_surroundings_m: 0}}\n", "t.yaml");
+  ASSERT_TRUE(off.ok()) << dump(off);
+  EXPECT_EQ(off.config.perception.filters.canopy_surroundings_m, 0.0);
+}
 
 TEST(ConfigLoad, MissingFileSaysSo) {
   const auto r = load_config_file("/nonexistent/fieldguard.yaml");
@@ -461,6 +490,89 @@ TEST(ConfigLoad, ReportsBadAnisotropicClusterKeys) {
   EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_margin_m", "out of range", 9)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.absorb_points", "unknown key", 10)) << dump(r);
   EXPECT_EQ(r.issues.size(), 5U) << dump(r);
+}
+
+// The floating-cluster rules (cluster_join.hpp, cluster_filter.hpp): read; left out, fieldguard.yaml's values.
+TEST(ConfigLoad, ReadsTheFloatingClusterKeys) {
+  const auto r = load_config_text(R"(
+perception:
+  cluster: {join_float_height_m: 0.9, join_gap_m: 0.7, join_stacked: false, join_stack_margin_m: 0.5}
+  filters: {float_min_height_m: 1.2, float_min_points: 4}
+)",
+                                  "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& c = r.config.perception.cluster;
+  EXPECT_DOUBLE_EQ(c.join_float_height_m, 0.9);
+  EXPECT_DOUBLE_EQ(c.join_gap_m, 0.7);
+  EXPECT_FALSE(c.join_stacked);
+  EXPECT_DOUBLE_EQ(c.join_stack_margin_m, 0.5);
+  EXPECT_DOUBLE_EQ(r.config.perception.filters.float_min_height_m, 1.2);
+  EXPECT_EQ(r.config.perception.filters.float_min_points, 4);
+  const auto d = load_config_text("perception: {}\n", "t.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_EQ(d.config.perception.cluster.join_float_height_m, 0.8);
+  EXPECT_EQ(d.config.perception.cluster.join_gap_m, 0.6);
+  EXPECT_TRUE(d.config.perception.cluster.join_stacked);
+  EXPECT_EQ(d.config.perception.cluster.join_stack_margin_m, 0.4);
+  EXPECT_EQ(d.config.perception.filters.float_min_height_m, 1.0);
+  EXPECT_EQ(d.config.perception.filters.float_min_points, 3);
+}
+
+TEST(ConfigLoad, ReportsBadFloatingClusterKeys) {
+  const std::string text =
+      "perception:\n"                       // 1
+      "  cluster:\n"                        // 2
+      "    join_float_height_m: -0.5\n"     // 3 out of range
+      "    join_gap_m: 20\n"                // 4 out of range
+      "    join_stacked: yes please\n"      // 5 not true or false
+      "    join_stack_margin_m: -1\n"       // 6 out of range
+      "  filters:\n"                        // 7
+      "    float_min_height_m: 11\n"        // 8 out of range
+      "    float_min_points: 0\n";          // 9 out of range
+  const auto r = load_config_text(text, "bad.yaml");
+  EXPECT_TRUE(has_issue(r, "perception.cluster.join_float_height_m", "out of range", 3)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.join_gap_m", "out of range", 4)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.join_stacked", "is not one of", 5)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.join_stack_margin_m", "out of range", 6)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.filters.float_min_height_m", "out of range", 8)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.filters.float_min_points", "out of range", 9)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 6U) << dump(r);
+}
+
+// The least height's growth with distance (cluster_filter.hpp): read; left out, fieldguard.yaml's values.
+TEST(ConfigLoad, ReadsTheHeightGrowthKeys) {
+  const auto r = load_config_text(
+      "perception: {filters: {min_height_growth_from_m: 20, min_height_growth_per_m: 0.04, "
+      "min_height_growth_max_m: 0.8}}\n",
+      "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& f = r.config.perception.filters;
+  EXPECT_DOUBLE_EQ(f.min_height_growth_from_m, 20.0);
+  EXPECT_DOUBLE_EQ(f.min_height_growth_per_m, 0.04);
+  EXPECT_DOUBLE_EQ(f.min_height_growth_max_m, 0.8);
+  const auto d = load_config_text("perception: {}\n", "t.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_EQ(d.config.perception.filters.min_height_growth_from_m, 25.0);
+  EXPECT_EQ(d.config.perception.filters.min_height_growth_per_m, 0.03);
+  EXPECT_EQ(d.config.perception.filters.min_height_growth_max_m, 0.75);
+}
+
+TEST(ConfigLoad, ReportsBadHeightGrowthKeys) {
+  const std::string text =
+      "perception:\n"                         // 1
+      "  filters:\n"                          // 2
+      "    min_height_growth_from_m: -5\n"    // 3 out of range
+      "    min_height_growth_per_m: 2\n";     // 4 out of range
+  const auto r = load_config_text(text, "bad.yaml");
+  EXPECT_TRUE(has_issue(r, "perception.filters.min_height_growth_from_m", "out of range", 3)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.filters.min_height_growth_per_m", "out of range", 4)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 2U) << dump(r);
+  // A cap under min_height_m would lower the threshold far out.
+  const auto c = load_config_text(
+      "perception:\n  filters:\n    min_height_m: 0.5\n    min_height_growth_max_m: 0.3\n", "bad.yaml");
+  EXPECT_TRUE(has_issue(c, "perception.filters.min_height_growth_max_m", "must not be less than min_height_m", 4))
+      << dump(c);
+  EXPECT_EQ(c.issues.size(), 1U) << dump(c);
 }
 
 // The ground stage's context beyond the ROI: read, range-checked; published.yaml keeps it off.

@@ -229,5 +229,156 @@ TEST(PipelineCanopy, CanopyIsNoObstacleButWhatStandsInOrBesideItIs) {
   }
 }
 
+// A slice of a crop canopy's top far out, as the level ring leaves it: two returns 30 m out at h 0.7 m, too few
+// for any triple of its own. Around it, two lower rings' returns (heights below the obstacle height): a porous
+// canopy (ranges jumping 0.3 m back and forth) or bare ground (ranges smooth).
+struct SliceScene {
+  Cloud frame;                // every voxel: the field's returns, then the slice's two points
+  std::vector<float> height;  // above the ground, one per point of `frame`
+  Cloud above;                // the slice alone (the non-ground cloud)
+  std::vector<std::uint32_t> in_frame{};
+  ClusterSummary s;
+};
+
+SliceScene slice_scene(bool porous_field, float slice_height = 0.7F) {
+  SliceScene sc;
+  constexpr float kRange = 30.F;
+  constexpr float kStep = 0.16F * std::numbers::pi_v<float> / 180.F;  // 10 Hz azimuth step
+  for (const float elevation_deg : {-1.333F, -2.667F}) {
+    const float t = std::tan(elevation_deg * std::numbers::pi_v<float> / 180.F);
+    for (int k = -30; k <= 30; ++k) {
+      const float b = 0.09F + kStep * static_cast<float>(k);
+      const float r = kRange + (porous_field ? ((k % 2 == 0) ? 0.15F : -0.15F) : 0.F);
+      sc.frame.push_back(r * std::cos(b), r * std::sin(b), r * t);
+      sc.height.push_back(0.1F);
+    }
+  }
+  for (const float db : {0.F, kStep}) {
+    const float b = 0.09F + db;
+    sc.in_frame.push_back(static_cast<std::uint32_t>(sc.frame.size()));
+    sc.frame.push_back(kRange * std::cos(b), kRange * std::sin(b), 0.F);
+    sc.height.push_back(0.3F);  // low enough to count as surroundings: only the marks keep it out
+    sc.above.push_back(kRange * std::cos(b), kRange * std::sin(b), 0.F);
+  }
+  sc.s.points = 2;
+  sc.s.min = {sc.above.x[1], sc.above.y[0], 0.F};
+  sc.s.max = {sc.above.x[0], sc.above.y[1], 0.F};
+  sc.s.distance_m = kRange;
+  sc.s.height_above_ground_m = slice_height;
+  return sc;
+}
+
+FilterParams surroundings_on() {
+  FilterParams f;  // fieldguard.yaml's canopy thresholds
+  f.canopy_surroundings_m = 2.0;
+  return f;
+}
+
+TEST(LowSurroundings, GathersTheClusterThenTheLowPointsAroundItsBox) {
+  SliceScene sc = slice_scene(true);
+  sc.height[0] = 0.6F;                    // not low: left out
+  sc.frame.push_back(40.F, 2.8F, -0.9F);  // far beyond the radius: left out
+  sc.height.push_back(0.F);
+  std::vector<std::uint8_t> skip(sc.frame.size(), 0U);
+  for (const std::uint32_t i : sc.in_frame) skip[i] = 1U;
+  LowSurroundings around;
+  around.min = {sc.s.min[0], sc.s.min[1]};
+  around.max = {sc.s.max[0], sc.s.max[1]};
+  around.radius_m = 2.F;
+  around.max_height_m = 0.5F;
+  Cloud out;
+  const std::vector<std::uint32_t> members{0, 1};
+  gather_low_surroundings(sc.above, members, sc.frame, sc.height, skip, around, out);
+  // The 2 slice points first, then the 122 field returns but the one too high (all lie within 2 m: the rings
+  // span 61 steps of 0.084 m = 5 m across, so not all: count those inside).
+  std::size_t inside = 0;
+  for (std::size_t i = 1; i < 122; ++i) {
+    const float x = sc.frame.x[i], y = sc.frame.y[i];
+    inside +=
+        (x >= around.min[0] - 2.F && x <= around.max[0] + 2.F && y >= around.min[1] - 2.F && y <= around.max[1] + 2.F)
+            ? 1U
+            : 0U;
+  }
+  ASSERT_GT(inside, 40U);
+  ASSERT_LT(inside, 121U);
+  ASSERT_EQ(out.size(), 2U + inside);
+  EXPECT_EQ(out.x[0], sc.above.x[0]);
+  EXPECT_EQ(out.y[1], sc.above.y[1]);
+  // Without the marks the slice's own points come in twice.
+  gather_low_surroundings(sc.above, members, sc.frame, sc.height, {}, around, out);
+  EXPECT_EQ(out.size(), 4U + inside);
+  const std::vector<float> short_heights(3, 0.F);
+  EXPECT_THROW(gather_low_surroundings(sc.above, members, sc.frame, short_heights, {}, around, out),
+               std::invalid_argument);
+  const std::vector<std::uint8_t> short_skip(3, 0U);
+  EXPECT_THROW(gather_low_surroundings(sc.above, members, sc.frame, sc.height, short_skip, around, out),
+               std::invalid_argument);
+}
+
+TEST(CheckCanopySurroundings, ASliceInAPorousFieldIsPorousOnBareGroundItIsNot) {
+  const FilterParams f = surroundings_on();
+  RingJitterMeter meter(1.333, f.canopy_max_gap_m);
+  Cloud scratch;
+  for (const bool porous : {true, false}) {
+    SliceScene sc = slice_scene(porous);
+    std::vector<std::uint8_t> marks(sc.frame.size(), 0U);
+    const FrameSurroundings frame{sc.frame, sc.height, sc.in_frame, marks};
+    const std::vector<std::uint32_t> members{0, 1};
+    // Alone, the slice says nothing.
+    EXPECT_EQ(check_canopy(f, sc.s, sc.above, members, meter), Rejection::Kept);
+    EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter),
+              porous ? Rejection::Porous : Rejection::Kept);
+    EXPECT_TRUE(std::all_of(marks.begin(), marks.end(), [](std::uint8_t v) { return v == 0U; }));
+  }
+}
+
+// What the rule must not drop: anything standing higher than a canopy (a person in the crop), a cluster with
+// enough triples of its own (check_canopy has told), and everything while the key is 0.
+TEST(CheckCanopySurroundings, TallClustersOwnEvidenceAndOffAreKept) {
+  RingJitterMeter meter(1.333, 0.5);
+  Cloud scratch;
+  const std::vector<std::uint32_t> members{0, 1};
+  {
+    SliceScene sc = slice_scene(true, 1.2F);
+    std::vector<std::uint8_t> marks(sc.frame.size(), 0U);
+    const FrameSurroundings frame{sc.frame, sc.height, sc.in_frame, marks};
+    EXPECT_EQ(check_canopy_surroundings(surroundings_on(), sc.s, sc.above, members, frame, scratch, meter),
+              Rejection::Kept);
+  }
+  SliceScene sc = slice_scene(true);
+  std::vector<std::uint8_t> marks(sc.frame.size(), 0U);
+  const FrameSurroundings frame{sc.frame, sc.height, sc.in_frame, marks};
+  FilterParams f = surroundings_on();
+  f.canopy_min_triples = 1;  // the slice's own triples (none) ... still too few: decided by the surroundings
+  EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter), Rejection::Porous);
+  f = surroundings_on();
+  f.canopy_surroundings_m = 0.0;
+  EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter), Rejection::Kept);
+  f = surroundings_on();
+  f.canopy_max_height_m = 0.0;
+  EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter), Rejection::Kept);
+  // A smooth solid slice of its own with plenty of triples (a box's face) standing in the porous field.
+  SliceScene box = slice_scene(true);
+  box.above.clear();
+  box.in_frame.clear();
+  std::vector<std::uint32_t> face;
+  for (int k = 0; k < 30; ++k) {
+    const float b = 0.09F + 0.0028F * static_cast<float>(k);
+    box.in_frame.push_back(static_cast<std::uint32_t>(box.frame.size()));
+    box.frame.push_back(29.F * std::cos(b), 29.F * std::sin(b), 0.F);
+    box.height.push_back(0.7F);
+    face.push_back(static_cast<std::uint32_t>(box.above.size()));
+    box.above.push_back(29.F * std::cos(b), 29.F * std::sin(b), 0.F);
+  }
+  std::vector<std::uint8_t> box_marks(box.frame.size(), 0U);
+  const FrameSurroundings box_frame{box.frame, box.height, box.in_frame, box_marks};
+  EXPECT_EQ(check_canopy_surroundings(surroundings_on(), box.s, box.above, face, box_frame, scratch, meter),
+            Rejection::Kept);
+  std::vector<std::uint8_t> wrong(3, 0U);
+  const FrameSurroundings bad{sc.frame, sc.height, sc.in_frame, wrong};
+  EXPECT_THROW((void)check_canopy_surroundings(surroundings_on(), sc.s, sc.above, members, bad, scratch, meter),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace fieldguard::perception

@@ -70,6 +70,63 @@ TEST(ClusterFilter, MinimumPointsFallsWithDistance) {
   EXPECT_EQ(min_points_at(f, 30.F), 10U);
 }
 
+// A crown seen through gaps floats: its lowest return stands well above the ground; crop, clods and people do not.
+TEST(ClusterFilter, AFloatingClusterNeedsFewerPoints) {
+  FilterParams f;  // 6 points up to 12 m
+  f.float_min_height_m = 1.0;
+  f.float_min_points = 3;
+  ClusterSummary s = summary(3, 10.F, {0.5F, 0.5F, 0.5F}, 2.5F);
+  s.lowest_above_ground_m = 1.2F;
+  EXPECT_EQ(min_points_of(f, s), 3U);
+  EXPECT_EQ(check_cluster(f, s), Rejection::Kept);
+  s.points = 2;
+  EXPECT_EQ(check_cluster(f, s), Rejection::TooFewPoints);
+  // Standing on the ground (or 0.99 m up): the distance rule.
+  s.points = 3;
+  s.lowest_above_ground_m = 0.99F;
+  EXPECT_EQ(min_points_of(f, s), 6U);
+  EXPECT_EQ(check_cluster(f, s), Rejection::TooFewPoints);
+  // Never more than the distance rule asks: far out 2 points do.
+  s.lowest_above_ground_m = 1.5F;
+  s.distance_m = 30.F;
+  EXPECT_EQ(min_points_of(f, s), 2U);
+  // Off (the default).
+  f.float_min_height_m = 0.0;
+  s.distance_m = 10.F;
+  EXPECT_EQ(min_points_of(f, s), 6U);
+}
+
+// Far out a ring's slice of a clod stands 0.5-0.65 m above ground measured by one or two rings; a person 1.4 m.
+TEST(ClusterFilter, LeastHeightGrowsWithDistance) {
+  FilterParams f;  // min_height_m 0.5
+  f.min_height_growth_from_m = 0.0;  // growth off
+  const ClusterSummary clod = summary(4, 40.F, {0.3F, 0.4F, 0.1F}, 0.6F);
+  const ClusterSummary person = summary(4, 40.F, {0.2F, 0.5F, 1.4F}, 1.4F);
+  EXPECT_EQ(check_cluster(f, clod), Rejection::Kept);  // off: the plain threshold
+  EXPECT_DOUBLE_EQ(min_height_at(f, 40.F), 0.5);
+  f.min_height_growth_from_m = 25.0;
+  f.min_height_growth_per_m = 0.03;
+  f.min_height_growth_max_m = 0.0;  // no cap
+  EXPECT_DOUBLE_EQ(min_height_at(f, 20.F), 0.5);
+  EXPECT_DOUBLE_EQ(min_height_at(f, 25.F), 0.5);
+  EXPECT_NEAR(min_height_at(f, 35.F), 0.8, 1e-6);
+  EXPECT_NEAR(min_height_at(f, 45.F), 1.1, 1e-6);  // no cap
+  EXPECT_EQ(check_cluster(f, clod), Rejection::TooLow);
+  EXPECT_EQ(check_cluster(f, person), Rejection::Kept);
+  // The same clod near: the plain threshold.
+  EXPECT_EQ(check_cluster(f, summary(30, 20.F, {0.3F, 0.4F, 0.1F}, 0.6F)), Rejection::Kept);
+  f.min_height_growth_max_m = 0.8;
+  EXPECT_NEAR(min_height_at(f, 45.F), 0.8, 1e-6);
+  // The defaults (config/fieldguard.yaml): 0.5 m up to 25 m, 0.03 m per metre beyond, capped at 0.75 m.
+  EXPECT_NEAR(min_height_at(FilterParams{}, 30.F), 0.65, 1e-6);
+  EXPECT_NEAR(min_height_at(FilterParams{}, 45.F), 0.75, 1e-6);
+  EXPECT_EQ(check_cluster(f, summary(4, 45.F, {0.3F, 0.4F, 0.1F}, 0.85F)), Rejection::Kept);
+  EXPECT_EQ(check_cluster(f, summary(4, 45.F, {0.3F, 0.4F, 0.1F}, 0.75F)), Rejection::TooLow);
+  // min_height_m 0 switches the height rule off altogether, growth included.
+  f.min_height_m = 0.0;
+  EXPECT_EQ(check_cluster(f, clod), Rejection::Kept);
+}
+
 TEST(ClusterFilter, Summary) {
   Cloud c;
   c.push_back(3.F, 4.F, -0.5F);
@@ -81,6 +138,7 @@ TEST(ClusterFilter, Summary) {
   EXPECT_EQ(s.points, 2U);
   EXPECT_FLOAT_EQ(s.distance_m, 5.F);  // horizontal, to the nearest point
   EXPECT_FLOAT_EQ(s.height_above_ground_m, 1.4F);
+  EXPECT_FLOAT_EQ(s.lowest_above_ground_m, 0.4F);
   EXPECT_EQ(s.min, (std::array<float, 3>{3.F, 4.F, -0.5F}));
   EXPECT_EQ(s.max, (std::array<float, 3>{6.F, 8.F, 0.5F}));
   EXPECT_FLOAT_EQ(s.volume_m3(), 12.F);

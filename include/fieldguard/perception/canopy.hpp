@@ -15,6 +15,7 @@
 // level (a canopy top, 0.2-0.5 m below the sensor) the voxel grid's centroids keep it too, since a centroid
 // that moves along the ray does not change its elevation. Thread-compatible.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -41,6 +42,8 @@ class RingJitterMeter {
   RingJitterMeter(double ring_spacing_deg, double max_gap_m);
 
   [[nodiscard]] RingJitter measure(const Cloud& cloud, std::span<const std::uint32_t> indices);
+  // Over every point of `cloud`.
+  [[nodiscard]] RingJitter measure_all(const Cloud& cloud);
 
  private:
   struct Sample {
@@ -50,6 +53,28 @@ class RingJitterMeter {
   float max_gap_m_;
   std::vector<Sample> samples_;  // scratch, reused
   std::vector<float> offs_;
+  std::vector<std::uint32_t> all_;
 };
+
+// A slice of a crop canopy's top (far out the sensor's level ring grazes the canopy, and each ring's returns on it
+// form their own small cluster) has too few returns to tell porous from solid, but it sits in the canopy: the
+// returns around it lower down (the canopy's front and the ground inside it, labelled ground or standing less
+// than the obstacle height) are rays stopping at random depths too, while a person on bare ground stands on
+// ground rings whose ranges change smoothly. Measured together with those, the slice's ring jitter says canopy
+// or not over enough triples.
+struct LowSurroundings {
+  std::array<float, 2> min{};  // the cluster's x-y box (m)
+  std::array<float, 2> max{};
+  float radius_m = 0.F;      // how far around the box on x and y (m)
+  float max_height_m = 0.F;  // points at least this high above their ground are not low (m)
+};
+
+// Writes to `out` the cluster's points (`members` of `cluster_cloud`), then every point of `cloud` lower than
+// around.max_height_m above its ground (`height_m`, one per point) whose x, y lie within around.radius_m of the box,
+// except those `skip` marks nonzero (the cluster's own points in `cloud`; empty: none). Throws
+// std::invalid_argument when `height_m` (or a non-empty `skip`) does not have one value per point of `cloud`.
+void gather_low_surroundings(const Cloud& cluster_cloud, std::span<const std::uint32_t> members, const Cloud& cloud,
+                             std::span<const float> height_m, std::span<const std::uint8_t> skip,
+                             const LowSurroundings& around, Cloud& out);
 
 }  // namespace fieldguard::perception

@@ -19,6 +19,7 @@ struct ClusterSummary {
   std::array<float, 3> max{};
   float distance_m = 0.F;             // horizontal distance from the sensor to the nearest point
   float height_above_ground_m = 0.F;  // of the highest point above its local ground
+  float lowest_above_ground_m = 0.F;  // of the lowest point above its local ground
   bool ground_guessed = false;        // every point stands on guessed ground (GroundLabels::guessed)
   [[nodiscard]] float volume_m3() const { return (max[0] - min[0]) * (max[1] - min[1]) * (max[2] - min[2]); }
 };
@@ -41,6 +42,14 @@ void limit_height_to_extent(ClusterSummary& s, float floor_z);
 // min_points * (full_range / d)^2 rounded up, but not below min_points_floor.
 [[nodiscard]] std::uint32_t min_points_at(const FilterParams& f, float distance_m);
 
+// The least point count of the cluster `s`: min_points_at its distance, or float_min_points if lower and it floats
+// (its lowest point at least float_min_height_m above its ground).
+[[nodiscard]] std::uint32_t min_points_of(const FilterParams& f, const ClusterSummary& s);
+
+// The least height above ground of a cluster at `distance_m`: min_height_m, or beyond min_height_growth_from_m
+// min_height_m + min_height_growth_per_m * (d - from), never above min_height_growth_max_m when that is set.
+[[nodiscard]] double min_height_at(const FilterParams& f, float distance_m);
+
 // Bounds are inclusive: a cluster of exactly min_points points, or exactly min_volume_m3, is kept.
 [[nodiscard]] Rejection check_cluster(const FilterParams& f, const ClusterSummary& s);
 
@@ -48,5 +57,25 @@ void limit_height_to_extent(ClusterSummary& s, float floor_z);
 // higher than canopy_max_height_m and its ring jitter (canopy.hpp) says canopy; else Kept.
 [[nodiscard]] Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
                                      std::span<const std::uint32_t> indices, RingJitterMeter& meter);
+
+// The frame around a cluster, for check_canopy_surroundings: every point (`cloud`, the voxels) with its height
+// above its ground; `in_cloud` maps each point of the cluster's cloud to its index in `cloud`; `marks` is scratch,
+// one zero per point of `cloud` (left zero).
+struct FrameSurroundings {
+  const Cloud& cloud;
+  std::span<const float> height_m;
+  std::span<const std::uint32_t> in_cloud;
+  std::span<std::uint8_t> marks;
+};
+
+// A third look (canopy_surroundings_m > 0) at a cluster check_canopy kept: one no higher than canopy_max_height_m
+// with fewer than canopy_min_triples triples of its own is Porous when its ring jitter measured together with its
+// low surroundings (gather_low_surroundings: within canopy_surroundings_m of its x-y box, lower than min_height_m
+// above their ground) reaches canopy_min_jitter_m over at least canopy_min_triples triples; else Kept. `scratch`
+// holds the gathered points afterwards.
+[[nodiscard]] Rejection check_canopy_surroundings(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
+                                                  std::span<const std::uint32_t> indices,
+                                                  const FrameSurroundings& frame, Cloud& scratch,
+                                                  RingJitterMeter& meter);
 
 }  // namespace fieldguard::perception

@@ -108,6 +108,14 @@ struct ClusterParams {
   // bigger cluster's box grown by absorb_margin_m joins it. 0 = off.
   int absorb_max_points = 10;
   double absorb_margin_m = 0.3;
+  // Then (cluster_join.hpp): a cluster whose lowest point is at least join_float_height_m above its ground
+  // floats; floating fragments too small for the filters join each other and their one nearest bigger cluster
+  // within join_gap_m (x-y boxes); with join_stacked a floating cluster joins every cluster whose x-y box is within
+  // join_stack_margin_m of its own on each axis. join_float_height_m 0 = off.
+  double join_float_height_m = 0.8;
+  double join_gap_m = 0.6;
+  bool join_stacked = true;
+  double join_stack_margin_m = 0.4;
 };
 
 struct FilterParams {
@@ -116,10 +124,20 @@ struct FilterParams {
   double min_volume_m3 = 0.0;
   double max_volume_m3 = 0.0;  // 0 = no upper limit
   double min_height_m = 0.5;   // highest point above the local ground; 0 = off
+  // Far out a ring's slice of a clod is a few returns whose height rests on ground measured by one or two rings:
+  // beyond min_height_growth_from_m the least height grows by min_height_growth_per_m per metre, up to
+  // min_height_growth_max_m (0 = no cap; a person, 1.4 m and more, should stay above it). from 0 = off.
+  double min_height_growth_from_m = 25.0;
+  double min_height_growth_per_m = 0.03;
+  double min_height_growth_max_m = 0.75;
   // Far objects get few returns: beyond this distance the minimum point count falls as
   // min_points * (min_points_full_range_m / d)^2, never below min_points_floor. 0 = off.
   double min_points_full_range_m = 12.0;
   int min_points_floor = 2;
+  // A cluster whose lowest point is at least float_min_height_m above its ground (a crown seen through gaps: crop,
+  // terrain and people never float) needs no more than float_min_points points. 0 = off.
+  double float_min_height_m = 1.0;
+  int float_min_points = 3;
   // Crop canopy (canopy.hpp): a cluster no higher than canopy_max_height_m above its ground whose ring jitter
   // is at least canopy_min_jitter_m, over at least canopy_min_triples triples of ring neighbours no farther
   // apart than canopy_max_gap_m, is porous: a crop or low foliage, not an obstacle. Anything standing higher
@@ -132,6 +150,10 @@ struct FilterParams {
   // canopy_needle_ratio times as deep as it is wide across them: a ray's returns inside a canopy. 0 = off.
   double canopy_needle_depth_m = 0.35;
   double canopy_needle_ratio = 3.0;
+  // ... or (canopy_surroundings_m > 0, and with too few triples of its own) measured together with the low returns
+  // within canopy_surroundings_m of its x-y box (ground-labelled, or lower than min_height_m above their ground):
+  // a ring slice of a crop canopy's top, sitting in the canopy (canopy.hpp, LowSurroundings). 0 = off.
+  double canopy_surroundings_m = 3.0;
 };
 
 // The 2D LiDAR's near field (near_field.hpp): the scan points of a merged frame become obstacles of their own,
@@ -161,7 +183,7 @@ struct NearFieldParams {
 
 struct PipelineParams {
   VoxelParams voxel;
-  Box3 roi{{-10.0, -10.0, -1.5}, {50.0, 10.0, 6.0}};
+  Box3 roi{{-10.0, -10.0, -6.0}, {50.0, 10.0, 6.0}};
   Box3 body{{-5.0, -1.5, -1.5}, {0.4, 1.5, 1.5}};
   GroundParams ground;
   ClusterParams cluster;

@@ -1,0 +1,158 @@
+#include "fieldguard/perception/cluster_join.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "fieldguard/perception/cluster_filter.hpp"
+
+namespace fieldguard::perception {
+
+namespace {
+
+constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+
+void check_length(double v, const char* what) {
+  if (!(v >= 0.0) || !std::isfinite(v)) {
+    throw std::invalid_argument(std::string("ClusterJoiner: ") + what + " must be finite and not negative");
+  }
+}
+
+}  // namespace
+
+ClusterJoiner::ClusterJoiner(const ClusterJoinParams& params) : params_(params) {
+  check_length(params.float_height_m, "float_height_m");
+  check_length(params.gap_m, "gap_m");
+  check_length(params.stack_margin_m, "stack_margin_m");
+}
+
+std::uint32_t ClusterJoiner::find(std::uint32_t c) {
+  while (parent_[c] != c) {
+    parent_[c] = parent_[parent_[c]];  // path halving
+    c = parent_[c];
+  }
+  return c;
+}
+
+bool ClusterJoiner::unite(std::uint32_t a, std::uint32_t b) {
+  const std::uint32_t ra = find(a), rb = find(b);
+  if (ra == rb) return false;
+  parent_[std::max(ra, rb)] = std::min(ra, rb);
+  return true;
+}
+
+float ClusterJoiner::gap_between(std::size_t a, std::size_t b) const {
+  const Info& p = info_[a];
+  const Info& q = info_[b];
+  const float gx = std::max(p.lo[0], q.lo[0]) - std::min(p.hi[0], q.hi[0]);
+  const float gy = std::max(p.lo[1], q.lo[1]) - std::min(p.hi[1], q.hi[1]);
+  return std::hypot(std::max(gx, 0.F), std::max(gy, 0.F));
+}
+
+std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> height_m, const FilterParams& filters,
+                                  Clusters& clusters) {
+  const std::size_t nc = clusters.size();
+  const bool fragments = params_.gap_m > 0.0;
+  if (!(params_.float_height_m > 0.0) || (!fragments && !params_.stacked) || nc < 2) return 0;
+  const std::size_t n = cloud.size();
+  if (height_m.size() < n) throw std::out_of_range("ClusterJoiner: fewer heights than points");
+  const auto float_h = static_cast<float>(params_.float_height_m);
+  constexpr float kBig = std::numeric_limits<float>::max();
+  info_.resize(nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const auto members = clusters[c];
+    Info s{{kBig, kBig}, {-kBig, -kBig}, false, false, members.empty()};
+    float low = kBig, r2 = kBig;
+    for (const std::uint32_t i : members) {
+      if (i >= n) throw std::out_of_range("ClusterJoiner: a cluster indexes a point past the cloud's end");
+      const float x = cloud.x[i], y = cloud.y[i];
+      s.lo[0] = std::min(s.lo[0], x);
+      s.hi[0] = std::max(s.hi[0], x);
+      s.lo[1] = std::min(s.lo[1], y);
+      s.hi[1] = std::max(s.hi[1], y);
+      low = std::min(low, height_m[i]);
+      r2 = std::min(r2, x * x + y * y);
+    }
+    if (!s.empty) {
+      s.floats = low >= float_h;
+      s.small = members.size() < min_points_at(filters, std::sqrt(r2));
+    }
+    info_[c] = s;
+  }
+  parent_.resize(nc);
+  for (std::size_t c = 0; c < nc; ++c) parent_[c] = static_cast<std::uint32_t>(c);
+  std::uint32_t joined = 0;
+
+  if (fragments) {
+    const auto gap = static_cast<float>(params_.gap_m);
+    // 1. Fragments with fragments.
+    for (std::size_t a = 0; a < nc; ++a) {
+      if (info_[a].empty || !info_[a].small) continue;
+      for (std::size_t b = a + 1; b < nc; ++b) {
+        const Info& q = info_[b];
+        if (q.empty || !q.small || !(info_[a].floats || q.floats) || gap_between(a, b) > gap) continue;
+        joined += unite(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b)) ? 1U : 0U;
+      }
+    }
+    // 2. Each group with a floating fragment: to its one nearest cluster with enough points. Every group's choice is
+    // made before any is applied, on the groups of step 1.
+    attach_.assign(nc, kNone);
+    attach_gap_.assign(nc, kBig);
+    group_floats_.assign(nc, 0);
+    for (std::size_t a = 0; a < nc; ++a) {
+      if (info_[a].empty || !info_[a].small) continue;
+      const std::uint32_t r = find(static_cast<std::uint32_t>(a));
+      if (info_[a].floats) group_floats_[r] = 1;
+      for (std::size_t b = 0; b < nc; ++b) {
+        if (info_[b].empty || info_[b].small) continue;
+        const float g = gap_between(a, b);
+        if (g <= gap && (g < attach_gap_[r] || (g == attach_gap_[r] && b < attach_[r]))) {
+          attach_gap_[r] = g;
+          attach_[r] = static_cast<std::uint32_t>(b);
+        }
+      }
+    }
+    for (std::size_t r = 0; r < nc; ++r) {
+      if (attach_[r] == kNone || group_floats_[r] == 0U) continue;
+      joined += unite(static_cast<std::uint32_t>(r), attach_[r]) ? 1U : 0U;
+    }
+  }
+  if (params_.stacked) {
+    // 3. Stacked: x-y boxes that overlap, or nearly (stack_margin_m on each axis).
+    const auto margin = static_cast<float>(params_.stack_margin_m);
+    for (std::size_t a = 0; a < nc; ++a) {
+      const Info& p = info_[a];
+      if (p.empty) continue;
+      for (std::size_t b = a + 1; b < nc; ++b) {
+        const Info& q = info_[b];
+        if (q.empty || !(p.floats || q.floats)) continue;
+        const float gx = std::max(p.lo[0], q.lo[0]) - std::min(p.hi[0], q.hi[0]);
+        const float gy = std::max(p.lo[1], q.lo[1]) - std::min(p.hi[1], q.hi[1]);
+        if (gx > margin || gy > margin) continue;
+        joined += unite(static_cast<std::uint32_t>(a), static_cast<std::uint32_t>(b)) ? 1U : 0U;
+      }
+    }
+  }
+  if (joined == 0) return 0;
+
+  // Relabel the points and rebuild in the order of each cluster's lowest point index. (Points in no cluster
+  // stay in none.)
+  of_point_.assign(n, kNone);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::uint32_t root = find(static_cast<std::uint32_t>(c));
+    for (const std::uint32_t i : clusters[c]) of_point_[i] = root;
+  }
+  id_.assign(nc, kNone);
+  std::uint32_t out_clusters = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (of_point_[i] == kNone) continue;
+    std::uint32_t& id = id_[of_point_[i]];
+    if (id == kNone) id = out_clusters++;
+    of_point_[i] = id;
+  }
+  group_points({of_point_.data(), n}, out_clusters, kNone, clusters, count_);
+  return joined;
+}
+
+}  // namespace fieldguard::perception
