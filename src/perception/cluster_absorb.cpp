@@ -68,22 +68,7 @@ std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
   }
   if (moved == 0) return 0;
 
-  // Relabel the points and rebuild in the order of each cluster's lowest point index. (Points in no cluster
-  // stay in none.)
-  constexpr std::uint32_t kNone = 0xFFFFFFFFU;
-  of_point_.assign(n, kNone);
-  for (std::size_t c = 0; c < nc; ++c) {
-    for (const std::uint32_t i : clusters[c]) of_point_[i] = target_[c];
-  }
-  id_.assign(nc, kNone);
-  std::uint32_t out_clusters = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (of_point_[i] == kNone) continue;
-    std::uint32_t& id = id_[of_point_[i]];
-    if (id == kNone) id = out_clusters++;
-    of_point_[i] = id;
-  }
-  group_points({of_point_.data(), n}, out_clusters, kNone, clusters, count_);
+  merge_clusters({target_.data(), nc}, n, clusters, of_point_, id_, count_);
   return moved;
 }
 

@@ -138,20 +138,9 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
 
   // Relabel the points and rebuild in the order of each cluster's lowest point index. (Points in no cluster
   // stay in none.)
-  of_point_.assign(n, kNone);
-  for (std::size_t c = 0; c < nc; ++c) {
-    const std::uint32_t root = find(static_cast<std::uint32_t>(c));
-    for (const std::uint32_t i : clusters[c]) of_point_[i] = root;
-  }
-  id_.assign(nc, kNone);
-  std::uint32_t out_clusters = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (of_point_[i] == kNone) continue;
-    std::uint32_t& id = id_[of_point_[i]];
-    if (id == kNone) id = out_clusters++;
-    of_point_[i] = id;
-  }
-  group_points({of_point_.data(), n}, out_clusters, kNone, clusters, count_);
+  root_.resize(nc);
+  for (std::size_t c = 0; c < nc; ++c) root_[c] = find(static_cast<std::uint32_t>(c));
+  merge_clusters({root_.data(), nc}, n, clusters, of_point_, id_, count_);
   return joined;
 }
 

@@ -490,4 +490,24 @@ void group_points(std::span<const std::uint32_t> cluster_of_point, std::uint32_t
   }
 }
 
+void merge_clusters(std::span<const std::uint32_t> target, std::size_t points, Clusters& clusters,
+                    Buffer<std::uint32_t>& of_point, Buffer<std::uint32_t>& id, Buffer<std::uint32_t>& scratch) {
+  constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  const std::size_t nc = clusters.size();
+  of_point.assign(points, kNone);
+  for (std::size_t c = 0; c < nc; ++c) {
+    for (const std::uint32_t i : clusters[c]) of_point[i] = target[c];
+  }
+  // Numbered by first appearance in point order: the order of each merged cluster's lowest point index.
+  id.assign(nc, kNone);
+  std::uint32_t out_clusters = 0;
+  for (std::size_t i = 0; i < points; ++i) {
+    if (of_point[i] == kNone) continue;
+    std::uint32_t& k = id[of_point[i]];
+    if (k == kNone) k = out_clusters++;
+    of_point[i] = k;
+  }
+  group_points({of_point.data(), points}, out_clusters, kNone, clusters, scratch);
+}
+
 }  // namespace fieldguard::perception

@@ -11,23 +11,9 @@
 namespace fieldguard::perception {
 namespace {
 
-using Sets = std::vector<std::vector<std::uint32_t>>;
-
-Sets sets_of(const Clusters& c) {
-  Sets s;
-  for (std::size_t i = 0; i < c.size(); ++i) s.emplace_back(c[i].begin(), c[i].end());
-  return s;
-}
-
-Clusters clusters_of(const Sets& sets) {
-  Clusters c;
-  c.offsets.push_back(0);
-  for (const auto& s : sets) {
-    c.indices.insert(c.indices.end(), s.begin(), s.end());
-    c.offsets.push_back(static_cast<std::uint32_t>(c.indices.size()));
-  }
-  return c;
-}
+using testing::clusters_of;
+using testing::Sets;
+using testing::sets_of;
 
 // A crown's body: a 4 x 4 x 4 lattice of 0.5 m (x 10..11.5 m, 64 points), and three stray returns behind it.
 Cloud crown_with_fragments() {

@@ -8,9 +8,29 @@
 
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/euclidean_cluster.hpp"
 #include "perception/random.hpp"
 
 namespace fieldguard::perception::testing {
+
+// Clusters as sets of point indices, and back: for stages that rewrite clusters (absorb, join).
+using Sets = std::vector<std::vector<std::uint32_t>>;
+
+inline Sets sets_of(const Clusters& c) {
+  Sets s;
+  for (std::size_t i = 0; i < c.size(); ++i) s.emplace_back(c[i].begin(), c[i].end());
+  return s;
+}
+
+inline Clusters clusters_of(const Sets& sets) {
+  Clusters c;
+  c.offsets.push_back(0);
+  for (const auto& s : sets) {
+    c.indices.insert(c.indices.end(), s.begin(), s.end());
+    c.offsets.push_back(static_cast<std::uint32_t>(c.indices.size()));
+  }
+  return c;
+}
 
 inline LidarPoint lidar_point(float x, float y, float z, std::uint16_t ring = 0) {
   LidarPoint p;

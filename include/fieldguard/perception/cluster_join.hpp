@@ -72,6 +72,7 @@ class ClusterJoiner {
   Buffer<std::uint32_t> attach_;  // per fragment group (its root): the cluster it joins
   Buffer<float> attach_gap_;
   Buffer<std::uint8_t> group_floats_;
+  Buffer<std::uint32_t> root_;  // per cluster: its union-find root, the cluster it ends in
   Buffer<std::uint32_t> of_point_;
   Buffer<std::uint32_t> id_;
   Buffer<std::uint32_t> count_;

@@ -39,6 +39,12 @@ struct Clusters {
 void group_points(std::span<const std::uint32_t> cluster_of_point, std::uint32_t count, std::uint32_t none,
                   Clusters& out, Buffer<std::uint32_t>& scratch);
 
+// Clusters merged in place: cluster c's points go to cluster target[c] (a cluster that is its own target), then
+// the clusters are rebuilt in the order of each one's lowest point index, members ascending (points of a cloud of
+// `points` in no cluster stay in none). The three buffers are scratch, reused.
+void merge_clusters(std::span<const std::uint32_t> target, std::size_t points, Clusters& clusters,
+                    Buffer<std::uint32_t>& of_point, Buffer<std::uint32_t>& id, Buffer<std::uint32_t>& scratch);
+
 class EuclideanClusterer {
  public:
   // Throws std::invalid_argument for a radius that is not positive, or an adaptive growth of 0.5 m per metre
