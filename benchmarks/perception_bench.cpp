@@ -484,6 +484,41 @@ void BM_ClusterJoin(benchmark::State& state) {
   state.counters["joins"] = static_cast<double>(joined);
 }
 
+// The joins' worst case: a frame of scattered single returns (rain, dust, a thin hedge far out), each its own
+// cluster, half of them floating. The joins compare clusters by their x-y boxes; this measures how that grows
+// with the count (range(0) clusters, over x 0..50 m, y -10..10 m).
+void BM_ClusterJoinScattered(benchmark::State& state) {
+  const auto count = static_cast<std::size_t>(state.range(0));
+  Cloud c;
+  std::vector<float> height;
+  std::uint64_t seed = 12345;
+  const auto next = [&seed] {  // a small LCG: the same cloud on every machine
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const float h = 3.F * next();
+    c.push_back(50.F * next(), 20.F * next() - 10.F, h - 0.95F);
+    height.push_back(h);
+  }
+  Clusters clustered;
+  clustered.offsets.push_back(0);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    clustered.indices.push_back(i);
+    clustered.offsets.push_back(i + 1);
+  }
+  ClusterJoiner joiner(ClusterJoinParams::from(fieldguard_params().cluster));
+  Clusters work;
+  std::uint32_t joined = 0;
+  for (auto _ : state) {
+    work = clustered;
+    joined = joiner.join(c, height, fieldguard_params().filters, work);
+    benchmark::DoNotOptimize(work.indices.data());
+  }
+  state.counters["joins"] = static_cast<double>(joined);
+  state.counters["clusters_out"] = static_cast<double>(work.size());
+}
+
 // fieldguard.yaml's pipeline without the crop-canopy rule (canopy.hpp) and the radial ground blend
 // (ZoneParams::blend_radial): their cost is BM_PipelineFieldguard's time minus this one's.
 void BM_PipelineFieldguardNoCanopy(benchmark::State& state) {
@@ -650,6 +685,7 @@ FG_BENCH(BM_ClusterAdaptiveGrid);
 FG_BENCH(BM_ClusterAnisotropicGrid);
 FG_BENCH(BM_ClusterAbsorb);
 FG_BENCH(BM_ClusterJoin);
+BENCHMARK(BM_ClusterJoinScattered)->Arg(1000)->Arg(4000)->Arg(16000)->Unit(benchmark::kMicrosecond);
 FG_BENCH(BM_PipelinePublished);
 FG_BENCH(BM_PipelineFieldguard);
 FG_BENCH(BM_PipelineFieldguardNoCanopy);

@@ -2,10 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
+#include <map>
+#include <random>
 #include <stdexcept>
 #include <vector>
 
+#include "fieldguard/perception/cluster_filter.hpp"
 #include "perception/test_clouds.hpp"
 
 namespace fieldguard::perception {
@@ -177,6 +182,137 @@ TEST(ClusterJoiner, EmptyClustersTakePartInNoRule) {
   ClusterJoiner j(params(0.8, 0.6, true));
   EXPECT_EQ(j.join(c, h, filters(), k), 1U);
   EXPECT_EQ(sets_of(k), (Sets{{0, 1}}));
+}
+
+// The three rules read straight from cluster_join.hpp, every pair of clusters compared: the reference the stage's
+// sweep along x must agree with.
+Sets reference_join(const Cloud& c, const std::vector<float>& h, const FilterParams& f, const ClusterJoinParams& p,
+                    const Sets& in) {
+  const std::size_t nc = in.size();
+  struct Box {
+    float lo[2], hi[2];
+    bool floats, small, empty;
+  };
+  std::vector<Box> box(nc);
+  for (std::size_t k = 0; k < nc; ++k) {
+    Box b{{1e30F, 1e30F}, {-1e30F, -1e30F}, false, false, in[k].empty()};
+    float low = 1e30F, r2 = 1e30F;
+    for (const std::uint32_t i : in[k]) {
+      b.lo[0] = std::min(b.lo[0], c.x[i]);
+      b.hi[0] = std::max(b.hi[0], c.x[i]);
+      b.lo[1] = std::min(b.lo[1], c.y[i]);
+      b.hi[1] = std::max(b.hi[1], c.y[i]);
+      low = std::min(low, h[i]);
+      r2 = std::min(r2, c.x[i] * c.x[i] + c.y[i] * c.y[i]);
+    }
+    b.floats = !b.empty && low >= static_cast<float>(p.float_height_m);
+    b.small = !b.empty && in[k].size() < min_points_at(f, std::sqrt(r2));
+    box[k] = b;
+  }
+  std::vector<std::size_t> up(nc);
+  for (std::size_t k = 0; k < nc; ++k) up[k] = k;
+  const auto root = [&](std::size_t k) {
+    while (up[k] != k) k = up[k];
+    return k;
+  };
+  const auto unite = [&](std::size_t a, std::size_t b) {
+    a = root(a);
+    b = root(b);
+    up[std::max(a, b)] = std::min(a, b);
+  };
+  const auto axis_gap = [&](std::size_t a, std::size_t b, int k) {
+    return std::max(box[a].lo[k], box[b].lo[k]) - std::min(box[a].hi[k], box[b].hi[k]);
+  };
+  const auto gap = [&](std::size_t a, std::size_t b) {
+    return std::hypot(std::max(axis_gap(a, b, 0), 0.F), std::max(axis_gap(a, b, 1), 0.F));
+  };
+  const auto g = static_cast<float>(p.gap_m);
+  if (p.gap_m > 0.0) {
+    for (std::size_t a = 0; a < nc; ++a) {
+      for (std::size_t b = a + 1; b < nc; ++b) {
+        if (box[a].small && box[b].small && (box[a].floats || box[b].floats) && gap(a, b) <= g) unite(a, b);
+      }
+    }
+    std::map<std::size_t, std::pair<float, std::size_t>> nearest;  // group root: (gap, big cluster)
+    std::map<std::size_t, bool> floats;
+    for (std::size_t a = 0; a < nc; ++a) {
+      if (!box[a].small) continue;
+      const std::size_t r = root(a);
+      floats[r] = floats[r] || box[a].floats;
+      for (std::size_t b = 0; b < nc; ++b) {
+        if (box[b].empty || box[b].small || gap(a, b) > g) continue;
+        const auto it = nearest.find(r);
+        if (it == nearest.end() || gap(a, b) < it->second.first ||
+            (gap(a, b) == it->second.first && b < it->second.second)) {
+          nearest[r] = {gap(a, b), b};
+        }
+      }
+    }
+    for (const auto& [r, choice] : nearest) {
+      if (floats[r]) unite(r, choice.second);
+    }
+  }
+  if (p.stacked) {
+    const auto m = static_cast<float>(p.stack_margin_m);
+    for (std::size_t a = 0; a < nc; ++a) {
+      for (std::size_t b = a + 1; b < nc; ++b) {
+        if (box[a].empty || box[b].empty || !(box[a].floats || box[b].floats)) continue;
+        if (axis_gap(a, b, 0) <= m && axis_gap(a, b, 1) <= m) unite(a, b);
+      }
+    }
+  }
+  std::map<std::size_t, std::vector<std::uint32_t>> groups;
+  for (std::size_t k = 0; k < nc; ++k) {
+    auto& members = groups[root(k)];
+    members.insert(members.end(), in[k].begin(), in[k].end());
+  }
+  Sets out;
+  for (auto& [r, members] : groups) {
+    if (members.empty()) continue;
+    std::sort(members.begin(), members.end());
+    out.push_back(members);
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.front() < b.front(); });
+  return out;
+}
+
+// Scattered clusters of 1-12 returns over 40 x 20 m, a third of them floating, with the stage against the reference:
+// the sweep along x must find every pair the rules name, whatever the clusters' order.
+TEST(ClusterJoiner, SweepAgreesWithEveryPairCompared) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> ux(5.F, 45.F), uy(-10.F, 10.F), spread(0.F, 0.8F), unit(0.F, 1.F);
+  std::size_t joins = 0;
+  for (int run = 0; run < 12; ++run) {
+    Cloud c;
+    std::vector<float> h;
+    Sets in;
+    const int count = 50 + 40 * run;
+    for (int k = 0; k < count; ++k) {
+      const float x = ux(rng), y = uy(rng), base = unit(rng) < 0.33F ? 0.8F + 2.F * unit(rng) : 0.5F * unit(rng);
+      const auto points = static_cast<int>(1 + 11 * unit(rng) * unit(rng));
+      std::vector<std::uint32_t> members;
+      for (int i = 0; i < points; ++i) {
+        members.push_back(static_cast<std::uint32_t>(c.size()));
+        c.push_back(x + spread(rng), y + spread(rng), base + spread(rng));
+        h.push_back(c.z[c.size() - 1]);
+      }
+      in.push_back(members);
+    }
+    std::shuffle(in.begin(), in.end(), rng);  // clusters in no particular order
+    const ClusterJoinParams p = params(0.8, run % 3 == 0 ? 0.0 : 0.6, run % 2 == 0, 0.4);
+    const Sets want = reference_join(c, h, filters(), p, in);
+    Clusters k = clusters_of(in);
+    ClusterJoiner j(p);
+    const std::uint32_t n = j.join(c, h, filters(), k);
+    joins += n;
+    if (n == 0) {
+      EXPECT_EQ(sets_of(k), in) << "run " << run;
+    } else {
+      EXPECT_EQ(sets_of(k), want) << "run " << run;
+    }
+    EXPECT_EQ(n, in.size() - want.size()) << "run " << run;
+  }
+  EXPECT_GT(joins, 100U);  // the scenes must exercise the rules
 }
 
 TEST(ClusterJoiner, BadInputThrows) {

@@ -72,6 +72,8 @@ class ClusterJoiner {
   Buffer<std::uint32_t> attach_;  // per fragment group (its root): the cluster it joins
   Buffer<float> attach_gap_;
   Buffer<std::uint8_t> group_floats_;
+  Buffer<std::uint32_t> order_;  // the sweep's clusters, by their low x edge
+  Buffer<std::uint32_t> big_;    // clusters with enough points for the filters
   Buffer<std::uint32_t> root_;  // per cluster: its union-find root, the cluster it ends in
   Buffer<std::uint32_t> of_point_;
   Buffer<std::uint32_t> id_;
