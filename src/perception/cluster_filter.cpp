@@ -92,8 +92,19 @@ Rejection check_cluster(const FilterParams& f, const ClusterSummary& s) {
   return Rejection::Kept;
 }
 
+namespace {
+
+// Porous when the ring jitter, over enough triples to tell, reaches canopy_min_jitter_m.
+Rejection by_jitter(const FilterParams& f, const RingJitter& j, std::uint32_t min_triples) {
+  if (j.triples < min_triples) return Rejection::Kept;
+  return static_cast<double>(j.median_m) >= f.canopy_min_jitter_m ? Rejection::Porous : Rejection::Kept;
+}
+
+}  // namespace
+
 Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
-                       std::span<const std::uint32_t> indices, RingJitterMeter& meter) {
+                       std::span<const std::uint32_t> indices, RingJitterMeter& meter, const FrameSurroundings* around,
+                       Cloud* scratch) {
   if (!(f.canopy_max_height_m > 0.0) || static_cast<double>(s.height_above_ground_m) > f.canopy_max_height_m) {
     return Rejection::Kept;
   }
@@ -105,35 +116,23 @@ Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Clo
       static_cast<double>(j.depth_m) >= f.canopy_needle_ratio * static_cast<double>(j.width_m)) {
     return Rejection::Porous;
   }
-  if (j.triples < static_cast<std::uint32_t>(std::max(f.canopy_min_triples, 1))) return Rejection::Kept;
-  return static_cast<double>(j.median_m) >= f.canopy_min_jitter_m ? Rejection::Porous : Rejection::Kept;
-}
-
-Rejection check_canopy_surroundings(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
-                                    std::span<const std::uint32_t> indices, const FrameSurroundings& frame,
-                                    Cloud& scratch, RingJitterMeter& meter) {
-  if (!(f.canopy_surroundings_m > 0.0) || !(f.canopy_max_height_m > 0.0) ||
-      static_cast<double>(s.height_above_ground_m) > f.canopy_max_height_m) {
-    return Rejection::Kept;
-  }
   const auto min_triples = static_cast<std::uint32_t>(std::max(f.canopy_min_triples, 1));
-  // Enough triples of its own: check_canopy has told already, and its surroundings do not overrule it (a solid
-  // box standing in a crop stays a box).
-  if (meter.measure(cloud, indices).triples >= min_triples) return Rejection::Kept;
+  if (j.triples >= min_triples || around == nullptr || scratch == nullptr || !(f.canopy_surroundings_m > 0.0)) {
+    return by_jitter(f, j, min_triples);
+  }
+  const FrameSurroundings& frame = *around;
   if (frame.marks.size() != frame.cloud.size() || frame.height_m.size() != frame.cloud.size()) {
-    throw std::invalid_argument("check_canopy_surroundings: one mark and one height per point of the frame");
+    throw std::invalid_argument("check_canopy: one mark and one height per point of the frame");
   }
   for (const std::uint32_t i : indices) frame.marks[frame.in_cloud[i]] = 1U;
-  LowSurroundings around;
-  around.min = {s.min[0], s.min[1]};
-  around.max = {s.max[0], s.max[1]};
-  around.radius_m = static_cast<float>(f.canopy_surroundings_m);
-  around.max_height_m = static_cast<float>(f.min_height_m);
-  gather_low_surroundings(cloud, indices, frame.cloud, frame.height_m, frame.marks, around, scratch);
+  LowSurroundings low;
+  low.min = {s.min[0], s.min[1]};
+  low.max = {s.max[0], s.max[1]};
+  low.radius_m = static_cast<float>(f.canopy_surroundings_m);
+  low.max_height_m = static_cast<float>(f.min_height_m);
+  gather_low_surroundings(cloud, indices, frame.cloud, frame.height_m, frame.marks, low, *scratch);
   for (const std::uint32_t i : indices) frame.marks[frame.in_cloud[i]] = 0U;
-  const RingJitter j = meter.measure_all(scratch);
-  if (j.triples < min_triples) return Rejection::Kept;
-  return static_cast<double>(j.median_m) >= f.canopy_min_jitter_m ? Rejection::Porous : Rejection::Kept;
+  return by_jitter(f, meter.measure_all(*scratch), min_triples);
 }
 
 }  // namespace fieldguard::perception

@@ -48,7 +48,7 @@ struct Pipeline::Impl {
   ClusterJoiner joiner;
   NearField near;
   RingJitterMeter jitter;
-  Cloud surroundings;                   // check_canopy_surroundings' scratch
+  Cloud surroundings;                   // check_canopy's scratch
   Buffer<std::uint8_t> surround_marks;  // ... and its marks, one per voxel, left zero
 
   Cloud cropped, voxels, above;
@@ -133,6 +133,8 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   m.joiner.join(m.above, m.above_height, m.params.filters, m.clusters);
 
   const FilterParams& f = m.params.filters;
+  if (f.canopy_surroundings_m > 0.0 && m.surround_marks.size() != n) m.surround_marks.assign(n, 0U);
+  const FrameSurroundings around{m.voxels, m.ground.height_m, m.above_index, m.surround_marks};
   for (std::size_t c = 0; c < m.clusters.size(); ++c) {
     const auto members = m.clusters[c];
     ClusterSummary s = summarize(m.above, m.above_height, m.above_guessed, members);
@@ -153,12 +155,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
       limit_height_to_extent(s, floor_z);
       why = check_cluster(f, s);
     }
-    if (why == Rejection::Kept) why = check_canopy(f, s, m.above, members, m.jitter);
-    if (why == Rejection::Kept && f.canopy_surroundings_m > 0.0) {
-      if (m.surround_marks.size() != n) m.surround_marks.assign(n, 0U);
-      const FrameSurroundings frame{m.voxels, m.ground.height_m, m.above_index, m.surround_marks};
-      why = check_canopy_surroundings(f, s, m.above, members, frame, m.surroundings, m.jitter);
-    }
+    if (why == Rejection::Kept) why = check_canopy(f, s, m.above, members, m.jitter, &around, &m.surroundings);
     // Too few points for its distance: not a cluster at all (PCL's minimum cluster size), left unclustered.
     if (why == Rejection::TooFewPoints) continue;
     ++result.counts.clusters;

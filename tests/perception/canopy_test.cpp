@@ -326,7 +326,7 @@ TEST(CheckCanopySurroundings, ASliceInAPorousFieldIsPorousOnBareGroundItIsNot) {
     const std::vector<std::uint32_t> members{0, 1};
     // Alone, the slice says nothing.
     EXPECT_EQ(check_canopy(f, sc.s, sc.above, members, meter), Rejection::Kept);
-    EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter),
+    EXPECT_EQ(check_canopy(f, sc.s, sc.above, members, meter, &frame, &scratch),
               porous ? Rejection::Porous : Rejection::Kept);
     EXPECT_TRUE(std::all_of(marks.begin(), marks.end(), [](std::uint8_t v) { return v == 0U; }));
   }
@@ -342,7 +342,7 @@ TEST(CheckCanopySurroundings, TallClustersOwnEvidenceAndOffAreKept) {
     SliceScene sc = slice_scene(true, 1.2F);
     std::vector<std::uint8_t> marks(sc.frame.size(), 0U);
     const FrameSurroundings frame{sc.frame, sc.height, sc.in_frame, marks};
-    EXPECT_EQ(check_canopy_surroundings(surroundings_on(), sc.s, sc.above, members, frame, scratch, meter),
+    EXPECT_EQ(check_canopy(surroundings_on(), sc.s, sc.above, members, meter, &frame, &scratch),
               Rejection::Kept);
   }
   SliceScene sc = slice_scene(true);
@@ -350,13 +350,13 @@ TEST(CheckCanopySurroundings, TallClustersOwnEvidenceAndOffAreKept) {
   const FrameSurroundings frame{sc.frame, sc.height, sc.in_frame, marks};
   FilterParams f = surroundings_on();
   f.canopy_min_triples = 1;  // the slice's own triples (none) ... still too few: decided by the surroundings
-  EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter), Rejection::Porous);
+  EXPECT_EQ(check_canopy(f, sc.s, sc.above, members, meter, &frame, &scratch), Rejection::Porous);
   f = surroundings_on();
   f.canopy_surroundings_m = 0.0;
-  EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter), Rejection::Kept);
+  EXPECT_EQ(check_canopy(f, sc.s, sc.above, members, meter, &frame, &scratch), Rejection::Kept);
   f = surroundings_on();
   f.canopy_max_height_m = 0.0;
-  EXPECT_EQ(check_canopy_surroundings(f, sc.s, sc.above, members, frame, scratch, meter), Rejection::Kept);
+  EXPECT_EQ(check_canopy(f, sc.s, sc.above, members, meter, &frame, &scratch), Rejection::Kept);
   // A smooth solid slice of its own with plenty of triples (a box's face) standing in the porous field.
   SliceScene box = slice_scene(true);
   box.above.clear();
@@ -372,11 +372,11 @@ TEST(CheckCanopySurroundings, TallClustersOwnEvidenceAndOffAreKept) {
   }
   std::vector<std::uint8_t> box_marks(box.frame.size(), 0U);
   const FrameSurroundings box_frame{box.frame, box.height, box.in_frame, box_marks};
-  EXPECT_EQ(check_canopy_surroundings(surroundings_on(), box.s, box.above, face, box_frame, scratch, meter),
+  EXPECT_EQ(check_canopy(surroundings_on(), box.s, box.above, face, meter, &box_frame, &scratch),
             Rejection::Kept);
   std::vector<std::uint8_t> wrong(3, 0U);
   const FrameSurroundings bad{sc.frame, sc.height, sc.in_frame, wrong};
-  EXPECT_THROW((void)check_canopy_surroundings(surroundings_on(), sc.s, sc.above, members, bad, scratch, meter),
+  EXPECT_THROW((void)check_canopy(surroundings_on(), sc.s, sc.above, members, meter, &bad, &scratch),
                std::invalid_argument);
 }
 

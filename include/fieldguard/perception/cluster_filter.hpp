@@ -53,14 +53,9 @@ void limit_height_to_extent(ClusterSummary& s, float floor_z);
 // Bounds are inclusive: a cluster of exactly min_points points, or exactly min_volume_m3, is kept.
 [[nodiscard]] Rejection check_cluster(const FilterParams& f, const ClusterSummary& s);
 
-// A second look at a cluster check_cluster kept, in its cloud (`indices` its points): Porous when it is no
-// higher than canopy_max_height_m and its ring jitter (canopy.hpp) says canopy; else Kept.
-[[nodiscard]] Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
-                                     std::span<const std::uint32_t> indices, RingJitterMeter& meter);
-
-// The frame around a cluster, for check_canopy_surroundings: every point (`cloud`, the voxels) with its height
-// above its ground; `in_cloud` maps each point of the cluster's cloud to its index in `cloud`; `marks` is scratch,
-// one zero per point of `cloud` (left zero).
+// The frame around a cluster, for check_canopy's look at its surroundings: every point (`cloud`, the voxels) with
+// its height above its ground; `in_cloud` maps each point of the cluster's cloud to its index in `cloud`; `marks`
+// is scratch, one zero per point of `cloud` (left zero).
 struct FrameSurroundings {
   const Cloud& cloud;
   std::span<const float> height_m;
@@ -68,14 +63,15 @@ struct FrameSurroundings {
   std::span<std::uint8_t> marks;
 };
 
-// A third look (canopy_surroundings_m > 0) at a cluster check_canopy kept: one no higher than canopy_max_height_m
-// with fewer than canopy_min_triples triples of its own is Porous when its ring jitter measured together with its
-// low surroundings (gather_low_surroundings: within canopy_surroundings_m of its x-y box, lower than min_height_m
-// above their ground) reaches canopy_min_jitter_m over at least canopy_min_triples triples; else Kept. `scratch`
-// holds the gathered points afterwards.
-[[nodiscard]] Rejection check_canopy_surroundings(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
-                                                  std::span<const std::uint32_t> indices,
-                                                  const FrameSurroundings& frame, Cloud& scratch,
-                                                  RingJitterMeter& meter);
+// A second look at a cluster check_cluster kept, in its cloud (`indices` its points): Porous when it is no
+// higher than canopy_max_height_m and its ring jitter (canopy.hpp) says canopy; else Kept. With fewer than
+// canopy_min_triples triples of its own, `around` given and canopy_surroundings_m > 0, its jitter is measured
+// together with its low surroundings instead (gather_low_surroundings: within canopy_surroundings_m of its x-y
+// box, lower than min_height_m above their ground); `scratch` then holds the gathered points. A cluster with
+// enough triples of its own is decided by them alone (a solid box standing in a crop stays a box).
+// Throws std::invalid_argument when `around` has not one mark and one height per point of its cloud.
+[[nodiscard]] Rejection check_canopy(const FilterParams& f, const ClusterSummary& s, const Cloud& cloud,
+                                     std::span<const std::uint32_t> indices, RingJitterMeter& meter,
+                                     const FrameSurroundings* around = nullptr, Cloud* scratch = nullptr);
 
 }  // namespace fieldguard::perception
