@@ -230,9 +230,10 @@ void EuclideanClusterer::extract_kdtree(const Cloud& in, Clusters& out) {
 // Cells: cubes of edge a bit under tolerance / sqrt(3), so that any two points of one cell are nearer than the
 // smallest radius and join. A cell is therefore a piece of one cluster, and clustering is union-find over
 // cells: two neighbouring cells join when any pair of their points is within the pair's radius (the test
-// stops at the first such pair, and is skipped when the two are already joined). A dense surface (a wall,
-// a shed's roof) thus costs a few tests per cell instead of a radius search per point. The connected components
-// are those of the point graph, so the clusters are exactly the k-d tree's.
+// stops at the first such pair, and is skipped when the two are already joined or the boxes of their points lie
+// beyond reach). A dense surface (a wall, a shed's roof) thus costs a few tests per cell instead of a radius
+// search per point. The connected components are those of the point graph, so the clusters are exactly the
+// k-d tree's.
 void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   const std::size_t n = in.size();
   float lo[3] = {in.x[0], in.y[0], in.z[0]};
@@ -340,10 +341,22 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   sorted_r2_.resize(n + 4);  // padded: the pair test reads four at a time
   if (anisotropic_) sorted_h2_.resize(n + 4);
   parent_.resize(ncells);
+  cell_box_.resize(6 * static_cast<std::size_t>(ncells));
   for (std::uint32_t c = 0; c < ncells; ++c) {
     parent_[c] = c;
     float m = base_r2_, mh = base_r2_;
+    float* box = cell_box_.data() + 6 * static_cast<std::size_t>(c);
+    const GridPoint& p0 = gp[cells_[c].first];
+    box[0] = box[3] = p0.x;
+    box[1] = box[4] = p0.y;
+    box[2] = box[5] = p0.z;
     for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) {
+      box[0] = std::min(box[0], gp[j].x);
+      box[1] = std::min(box[1], gp[j].y);
+      box[2] = std::min(box[2], gp[j].z);
+      box[3] = std::max(box[3], gp[j].x);
+      box[4] = std::max(box[4], gp[j].y);
+      box[5] = std::max(box[5], gp[j].z);
       const float r2 = adaptive_ ? r2_[gp[j].index] : base_r2_;
       sorted_r2_[j] = r2;
       m = std::max(m, r2);
@@ -400,6 +413,14 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     if (cb.hreach2 != ca.hreach2) return cb.hreach2 < ca.hreach2;
     return b < a;
   };
+  // Per column: its lowest cell in that order (col_next_ is free until the clusters are grouped). A column whose
+  // lowest cell is not below a has no cell a looks for: a passes over it whole. (Radii grow with range, so most
+  // columns on a's far side.)
+  std::uint32_t* const col_low = col_next_.data();
+  for (std::uint32_t b = 0; b < ncells; ++b) {
+    const std::uint32_t col = cells_[b].col, low = col_low[col];
+    if (b == col_cells_[col] || below(cells_[b], b, cells_[low], low)) col_low[col] = b;
+  }
   for (std::uint32_t a = 0; a < ncells; ++a) {
     const Cell& ca = cells_[a];
     const std::uint32_t a0 = ca.first, a1 = cells_[a + 1].first;
@@ -415,6 +436,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
       return aniso ? joins_anisotropic(gxy, gz * gz, hreach2, reach2) : gxy + gz * gz < reach2;
     };
     std::uint32_t ra = find_root(parent, a);  // kept up to date: only this loop joins a's root to another
+    const float* const abox = cell_box_.data() + 6 * static_cast<std::size_t>(a);
     for (std::int64_t x = std::max<std::int64_t>(0, ax - hreach);
          x <= std::min<std::int64_t>(ax + hreach, static_cast<std::int64_t>(nx) - 1); ++x) {
       const float gx = gap_at[x - ax];
@@ -424,6 +446,8 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
         std::uint32_t b = col_cells_[col];
         const std::uint32_t last = col_cells_[col + 1];
         if (b == last) continue;  // an empty column (most are)
+        const std::uint32_t low = col_low[col];
+        if (!below(cells_[low], low, ca, a)) continue;
         const float gy = gap_at[y - ay];
         const float gxy = gx * gx + gy * gy;
         if (!(gxy < hreach2) || !within(gxy, 0)) continue;
@@ -443,6 +467,16 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
           if (!below(cb, b, ca, a)) continue;
           const std::uint32_t rb = find_root(parent, b);
           if (ra == rb) continue;
+          // The gap between the two cells' point boxes on each axis, taken short by kSlack: no two of their
+          // points are nearer. Beyond a's radii there (b's are no larger), none of their pairs joins: many cells
+          // a column's z run reaches only by the lattice (a far wall's tall cells, its edge columns) end here.
+          const float* const bbox = cell_box_.data() + 6 * static_cast<std::size_t>(b);
+          const auto box_gap = [&](int k) {
+            return std::max(0.F, std::max(bbox[k] - abox[k + 3], abox[k] - bbox[k + 3]) - kSlack);
+          };
+          const float bx = box_gap(0), by = box_gap(1), bz = box_gap(2);
+          const float bxy2 = bx * bx + by * by;
+          if (!(aniso ? joins_anisotropic(bxy2, bz * bz, hreach2, reach2) : bxy2 + bz * bz < reach2)) continue;
           if (cells_join(a0, a1, cb.first, cells_[b + 1].first, sx, sy, sz, r2, h2, aniso)) {
             parent[std::max(ra, rb)] = std::min(ra, rb);
             ra = std::min(ra, rb);

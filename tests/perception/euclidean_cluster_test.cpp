@@ -389,6 +389,65 @@ TEST(EuclideanClusterer, FarTallCellsStayExact) {
   }
 }
 
+// The grid passes over a column with no cell below the looking cell in the radii order. That column's lowest cell
+// may be mid-column (its point nearest the sensor), not its first: a point in the next column beside a column
+// 20 m out, nearer than the column's bottom point and farther than its middle one, joins the middle one; bottom
+// and top, 3 m away, stay apart.
+TEST(EuclideanClusterer, GridLooksIntoAColumnThroughItsNearestCell) {
+  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
+    Cloud c;
+    c.push_back(20.F, 0.F, -3.F);
+    c.push_back(20.F, 0.F, 0.F);
+    c.push_back(20.F, 0.F, 3.F);
+    c.push_back(20.F, 0.25F, 0.1F);  // y: the next column (cells of 0.4 / sqrt(3) m)
+    for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+      EuclideanClusterer e(params(method, structure, 0.4));
+      Clusters out;
+      e.extract(c, out);
+      EXPECT_EQ(sets_of(out), (ClusterSets{{0}, {1, 3}, {2}}))
+          << method_name(method) << (structure == ClusterStructure::Grid ? " grid" : " kd");
+    }
+  }
+}
+
+// The grid skips a cell pair whose point boxes are farther apart than the looking cell's radii. Pairs of small
+// clumps whose nearest points lie just inside or just outside the joining distance, in every direction (the
+// vertical and horizontal radii differ), 5-45 m out: the k-d tree's clusters, with both outcomes common.
+TEST(EuclideanClusterer, GridCellBoxesKeepPairsNearTheRadius) {
+  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
+    const EuclideanClusterer probe(params(method, ClusterStructure::Grid, 0.4));
+    testing::TestRng rng{47};
+    Cloud c;
+    constexpr int kPairs = 150;  // 4 m apart side by side, 9 m on top of each other: each pair alone
+    for (int k = 0; k < kPairs; ++k) {
+      const float px = 5.F + 4.F * static_cast<float>(k % 10), py = -8.F + 4.F * static_cast<float>(k / 10 % 5);
+      const float pz = rng.uniform(-1.5F, 0.F) + 9.F * static_cast<float>(k / 50);
+      const float range = std::sqrt(px * px + py * py + pz * pz);
+      const float h = probe.horizontal_radius_at(range), v = probe.radius_at(range);
+      const float az = rng.uniform(0.F, 2.F * std::numbers::pi_v<float>), el = rng.uniform(-1.5F, 1.5F);
+      const float f = rng.uniform(0.97F, 1.03F);
+      const float dx = f * h * std::cos(el) * std::cos(az), dy = f * h * std::cos(el) * std::sin(az);
+      const float dz = f * v * std::sin(el);
+      c.push_back(px, py, pz);
+      c.push_back(px + dx, py + dy, pz + dz);
+      // each end a clump: its other points on the far side from the other end
+      for (int i = 0; i < 3; ++i) {
+        const float s = rng.uniform(0.02F, 0.08F);
+        c.push_back(px - s * dx, py - s * dy, pz - s * dz);
+        c.push_back(px + (1.F + s) * dx, py + (1.F + s) * dy, pz + (1.F + s) * dz);
+      }
+    }
+    Clusters a, b;
+    EuclideanClusterer kd(params(method, ClusterStructure::KdTree, 0.4));
+    EuclideanClusterer grid(params(method, ClusterStructure::Grid, 0.4));
+    kd.extract(c, a);
+    grid.extract(c, b);
+    EXPECT_GT(a.size(), static_cast<std::size_t>(kPairs) * 6 / 5) << method_name(method);
+    EXPECT_LT(a.size(), static_cast<std::size_t>(kPairs) * 9 / 5) << method_name(method);
+    EXPECT_EQ(sets_of(a), sets_of(b)) << method_name(method);
+  }
+}
+
 TEST(EuclideanClusterer, AnisotropicRadii) {
   const EuclideanClusterer e(params(ClusterMethod::Anisotropic, ClusterStructure::Grid, 0.4));
   const float gap = std::tan(1.33F * kDeg);

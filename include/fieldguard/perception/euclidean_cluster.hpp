@@ -113,7 +113,8 @@ class EuclideanClusterer {
   Buffer<std::uint32_t> parent_;     // union-find over cells
   Buffer<std::uint32_t> cluster_of_root_;
   Buffer<std::uint8_t> mark_;
-  Buffer<float> gaps_;  // grid: the gap between cells per offset
+  Buffer<float> gaps_;      // grid: the gap between cells per offset
+  Buffer<float> cell_box_;  // grid: per cell, the box of its points (min x, y, z, max x, y, z)
 };
 
 }  // namespace fieldguard::perception
