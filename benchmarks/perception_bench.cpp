@@ -50,6 +50,7 @@
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/perception/cluster_absorb.hpp"
 #include "fieldguard/perception/cluster_join.hpp"
+#include "fieldguard/perception/cluster_split.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/near_field.hpp"
@@ -484,6 +485,37 @@ void BM_ClusterJoin(benchmark::State& state) {
   state.counters["joins"] = static_cast<double>(joined);
 }
 
+// The split of clusters holding two crowns (cluster_split.hpp; no PCL counterpart) with the candidate keys
+// (/work/scenes/cand-C3.yaml: examined from 2 m long; fieldguard.yaml leaves it off), on fieldguard.yaml's clusters
+// after absorption and joins: the stage's cost is the clusters long enough to be looked at (the shed's walls).
+void BM_ClusterSplit(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const ClusterParams& cp = fieldguard_params().cluster;
+  EuclideanClusterer clusterer(cp);
+  ClusterAbsorber absorber(cp.absorb_max_points, cp.absorb_margin_m);
+  ClusterJoiner joiner(ClusterJoinParams::from(cp));
+  Clusters clustered, work;
+  clusterer.extract(f.above, clustered);
+  absorber.absorb(f.above, clustered);
+  const auto sensor_h = static_cast<float>(fieldguard_params().ground.zones.sensor_height_m);
+  std::vector<float> height(f.above.z.begin(), f.above.z.end());
+  for (float& h : height) h += sensor_h;
+  joiner.join(f.above, height, fieldguard_params().filters, clustered);
+  ClusterSplitParams sp = ClusterSplitParams::from(cp);
+  sp.min_length_m = 2.0;
+  ClusterSplitter splitter(sp);
+  std::uint32_t cuts = 0;
+  paired(state, "cluster split (two crowns)", static_cast<int>(state.range(0)), f.above.size(),
+         [&] {
+           work = clustered;  // the stage rewrites its input: timed with this copy
+           cuts = splitter.split(f.above, clusterer, work);
+           benchmark::DoNotOptimize(work.indices.data());
+         },
+         {});
+  state.counters["clusters_in"] = static_cast<double>(clustered.size());
+  state.counters["cuts"] = static_cast<double>(cuts);
+}
+
 // The joins' worst case: a frame of scattered single returns (rain, dust, a thin hedge far out), each its own
 // cluster, half of them floating. The joins compare clusters by their x-y boxes; this measures how that grows
 // with the count (range(0) clusters, over x 0..50 m, y -10..10 m).
@@ -685,6 +717,7 @@ FG_BENCH(BM_ClusterAdaptiveGrid);
 FG_BENCH(BM_ClusterAnisotropicGrid);
 FG_BENCH(BM_ClusterAbsorb);
 FG_BENCH(BM_ClusterJoin);
+FG_BENCH(BM_ClusterSplit);
 BENCHMARK(BM_ClusterJoinScattered)->Arg(1000)->Arg(4000)->Arg(16000)->Unit(benchmark::kMicrosecond);
 FG_BENCH(BM_PipelinePublished);
 FG_BENCH(BM_PipelineFieldguard);

@@ -175,7 +175,8 @@ void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
   if (!r.section(z, path,
                  {"edges_m", "rings", "sectors", "min_bin_points", "seed_lowest", "seed_margin_m", "fit_distance_m",
                   "fit_iterations", "ground_threshold_m", "max_slope_deg", "max_tilt_deg", "max_step_m",
-                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m", "blend_radial"})) {
+                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m", "blend_radial",
+                  "max_below_m"})) {
     return;
   }
   // The lists are checked against each other only when each was read (a bad list has its own issue).
@@ -195,6 +196,7 @@ void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
   r.number(z, path, "min_spread_m", p.min_spread_m, 0.0, 100.0, "m");
   r.number(z, path, "max_extrapolation_m", p.max_extrapolation_m, 0.0, 500.0, "m");
   if (auto e = r.choice(z, path, "blend_radial", {"false", "true"})) p.blend_radial = *e == 1;
+  r.number(z, path, "max_below_m", p.max_below_m, 0.0, 10.0, "m");
   for (std::size_t i = 1; i < p.edges_m.size(); ++i) {
     if (!(p.edges_m[i] > p.edges_m[i - 1])) {
       r.issue(value_or(z, "edges_m"), path + ".edges_m", "zone edges must increase from the sensor outwards");
@@ -237,7 +239,9 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   if (!r.section(c, path,
                  {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m",
                   "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m",
-                  "join_float_height_m", "join_gap_m", "join_stacked", "join_stack_margin_m"})) {
+                  "join_float_height_m", "join_gap_m", "join_stacked", "join_stack_margin_m",
+                  "split_min_length_m", "split_min_part_m", "split_gap_ratio",
+                  "split_min_part_points", "split_full_range_m"})) {
     return;
   }
   if (auto m = r.choice(c, path, "method", {"fixed", "adaptive", "anisotropic"})) {
@@ -260,6 +264,11 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   r.number(c, path, "join_gap_m", p.join_gap_m, 0.0, 10.0, "m");
   if (auto j = r.choice(c, path, "join_stacked", {"false", "true"})) p.join_stacked = *j == 1;
   r.number(c, path, "join_stack_margin_m", p.join_stack_margin_m, 0.0, 10.0, "m");
+  r.number(c, path, "split_min_length_m", p.split_min_length_m, 0.0, 100.0, "m");
+  r.number(c, path, "split_min_part_m", p.split_min_part_m, 0.0, 100.0, "m");
+  r.number(c, path, "split_gap_ratio", p.split_gap_ratio, 0.05, 10.0, "");
+  r.integer(c, path, "split_min_part_points", p.split_min_part_points, 0, 1000000);
+  r.number(c, path, "split_full_range_m", p.split_full_range_m, 0.1, 500.0, "m");
   // A radius that grows with range: from tolerance_m up to its cap, by factor * tan(beam_spacing) per metre.
   const auto check_growth = [&](const char* cap_key, double cap, const char* factor_key, double factor,
                                 const char* which) {

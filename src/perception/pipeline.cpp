@@ -10,6 +10,7 @@
 #include "fieldguard/perception/cluster_absorb.hpp"
 #include "fieldguard/perception/cluster_filter.hpp"
 #include "fieldguard/perception/cluster_join.hpp"
+#include "fieldguard/perception/cluster_split.hpp"
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/near_field.hpp"
@@ -27,6 +28,7 @@ struct Pipeline::Impl {
         clusterer(p.cluster),
         absorber(p.cluster.absorb_max_points, p.cluster.absorb_margin_m),
         joiner(ClusterJoinParams::from(p.cluster)),
+        splitter(ClusterSplitParams::from(p.cluster)),
         near(p.near_field),
         jitter(p.cluster.beam_spacing_deg, p.filters.canopy_max_gap_m) {
     if (p.roi.min[0] >= p.roi.max[0] || p.roi.min[1] >= p.roi.max[1] || p.roi.min[2] >= p.roi.max[2]) {
@@ -46,6 +48,7 @@ struct Pipeline::Impl {
   EuclideanClusterer clusterer;
   ClusterAbsorber absorber;
   ClusterJoiner joiner;
+  ClusterSplitter splitter;
   NearField near;
   RingJitterMeter jitter;
   Cloud surroundings;                   // check_canopy's scratch
@@ -131,6 +134,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   m.clusterer.extract(m.above, m.clusters);
   m.absorber.absorb(m.above, m.clusters);
   m.joiner.join(m.above, m.above_height, m.params.filters, m.clusters);
+  m.splitter.split(m.above, m.clusterer, m.clusters);
 
   const FilterParams& f = m.params.filters;
   if (f.canopy_surroundings_m > 0.0 && m.surround_marks.size() != n) m.surround_marks.assign(n, 0U);

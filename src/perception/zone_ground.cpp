@@ -195,6 +195,15 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   const float dist = std::sqrt(ddx * ddx + ddy * ddy);
   const float allowed = static_cast<float>(params_.max_step_m) + dist * max_change;
   if (std::fabs(step) > allowed) return;
+  // A ground plane is the lower envelope of its bin's returns. One with a return of its own bin far below it
+  // was fitted to something standing there: behind a tree row only the near-horizontal lasers reach the next
+  // row's crowns, and their returns make a flat, wide "ground" a metre up, with a lower laser's return under it.
+  if (params_.max_below_m > 0.0) {
+    const float deepest = -static_cast<float>(params_.max_below_m);
+    for (std::size_t i = 0; i < m; ++i) {
+      if (bz_[i] - f.plane.z_at(bx_[i], by_[i]) < deepest) return;
+    }
+  }
   out.plane = f.plane;
   out.ref_x = f.mean_x;
   out.ref_y = f.mean_y;

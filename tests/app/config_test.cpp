@@ -111,6 +111,7 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(z.max_slope_change_deg, dz.max_slope_change_deg);
   EXPECT_EQ(z.min_spread_m, dz.min_spread_m);
   EXPECT_EQ(z.max_extrapolation_m, dz.max_extrapolation_m);
+  EXPECT_EQ(z.max_below_m, dz.max_below_m);
   EXPECT_EQ(z.sensor_height_m, dz.sensor_height_m);  // lidar.mounting.z_m 0.95
   EXPECT_EQ(p.ground.context_m, d.ground.context_m);
   EXPECT_EQ(p.cluster.method, d.cluster.method);
@@ -586,6 +587,63 @@ TEST(ConfigLoad, ReadsTheGroundContext) {
   const auto published = load_config_file(std::string(FIELDGUARD_SOURCE_DIR) + "/config/published.yaml");
   ASSERT_TRUE(published.ok()) << dump(published);
   EXPECT_EQ(published.config.perception.ground.context_m, 0.0);
+}
+
+// The zone ground's lower-envelope rule (zone_ground.hpp): read; left out, off.
+TEST(ConfigLoad, ReadsTheGroundMaxBelowKey) {
+  const auto r = load_config_text("perception: {ground: {zones: {max_below_m: 0.3}}}\n", "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  EXPECT_DOUBLE_EQ(r.config.perception.ground.zones.max_below_m, 0.3);
+  const auto d = load_config_text("perception: {}\n", "t.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_EQ(d.config.perception.ground.zones.max_below_m, 0.0);
+}
+
+TEST(ConfigLoad, ReportsABadGroundMaxBelow) {
+  for (const char* bad : {"-0.1", "11", "deep"}) {
+    const std::string text = std::string("perception:\n  ground:\n    zones:\n      max_below_m: ") + bad + "\n";
+    const auto r = load_config_text(text, "bad.yaml");
+    EXPECT_FALSE(r.ok()) << bad;
+    EXPECT_TRUE(has_issue(r, "perception.ground.zones.max_below_m", std::string(bad) == "deep" ? "expected a number" : "out of range", 4))
+        << bad << ": " << dump(r);
+    EXPECT_EQ(r.issues.size(), 1U) << dump(r);
+  }
+}
+
+// The split of clusters holding two crowns (cluster_split.hpp): read; left out, off; bad values reported.
+TEST(ConfigLoad, ReadsAndChecksTheClusterSplitKeys) {
+  const auto r = load_config_text(R"(
+perception:
+  cluster: {split_min_length_m: 2.5, split_min_part_m: 0.6, split_gap_ratio: 0.7, split_min_part_points: 30,
+            split_full_range_m: 12.0}
+)",
+                                  "t.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& c = r.config.perception.cluster;
+  EXPECT_DOUBLE_EQ(c.split_min_length_m, 2.5);
+  EXPECT_DOUBLE_EQ(c.split_min_part_m, 0.6);
+  EXPECT_DOUBLE_EQ(c.split_gap_ratio, 0.7);
+  EXPECT_EQ(c.split_min_part_points, 30);
+  EXPECT_DOUBLE_EQ(c.split_full_range_m, 12.0);
+  const auto d = load_config_text("perception:\n  cluster: {method: anisotropic}\n", "d.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_EQ(d.config.perception.cluster.split_min_length_m, 0.0);  // off unless asked for
+
+  const std::string text =
+      "perception:\n"                         // 1
+      "  cluster:\n"                          // 2
+      "    split_min_length_m: -1\n"          // 3 out of range
+      "    split_min_part_m: 200\n"           // 4 out of range
+      "    split_gap_ratio: .nan\n"           // 5 not a number
+      "    split_min_part_points: -3\n"       // 6 out of range
+      "    split_full_range_m: 0\n";          // 7 out of range: the scale divides by it
+  const auto bad = load_config_text(text, "bad.yaml");
+  EXPECT_TRUE(has_issue(bad, "perception.cluster.split_min_length_m", "out of range", 3)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "perception.cluster.split_min_part_m", "out of range", 4)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "perception.cluster.split_gap_ratio", "expected a number", 5)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "perception.cluster.split_min_part_points", "out of range", 6)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "perception.cluster.split_full_range_m", "out of range", 7)) << dump(bad);
+  EXPECT_EQ(bad.issues.size(), 5U) << dump(bad);
 }
 
 }  // namespace

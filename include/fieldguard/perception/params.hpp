@@ -68,6 +68,10 @@ struct ZoneParams {
   // ring out, metres away, is where the ground there was measured: without this a ring's slice of a ridge at
   // a bin's outer edge stands tenths of a metre above a plane that the bin beyond contradicts.
   bool blend_radial = true;
+  // The ground is the lower envelope of its bin's returns: a bin with a return of its own more than this below its
+  // fitted plane keeps the plane continued from inside (m; 0 = off). Behind a tree row only the near-horizontal
+  // lasers reach the next row's crowns; a plane fitted to their returns has a lower laser's crown return under it.
+  double max_below_m = 0.0;
   double sensor_height_m = 0.95;  // the LiDAR above flat ground; the loader copies lidar.mounting.z_m
 };
 
@@ -116,6 +120,15 @@ struct ClusterParams {
   double join_gap_m = 0.6;
   bool join_stacked = true;
   double join_stack_margin_m = 0.4;
+  // Last (cluster_split.hpp): a cluster at least split_min_length_m long along its long x-y axis is cut in two at the
+  // widest empty slot across it that is at least split_gap_ratio times the horizontal radius there, when each part is
+  // at least split_min_part_m long with split_min_part_points points (falling as (split_full_range_m / r)^2 beyond
+  // split_full_range_m): two crowns side by side. split_min_length_m 0 = off.
+  double split_min_length_m = 0.0;
+  double split_min_part_m = 0.5;
+  double split_gap_ratio = 0.6;
+  int split_min_part_points = 40;
+  double split_full_range_m = 10.0;
 };
 
 struct FilterParams {

@@ -14,12 +14,14 @@
 // ground plane: not steeper than max_slope_deg, its slope within max_slope_change_deg of the prior's, its
 // points spread over at least min_spread_m (a person's legs do not), and its height continuing the prior's
 // (within max_step_m plus the rise of max_slope_change_deg over the distance: a haystack, a crop block, a
-// building do not). Otherwise it continues the prior's plane. Once every bin is done, a bin without its own
-// plane gets the planes around it (continued from inside, the first fitted bin outside it, the nearest fitted
-// ones either side in its ring) blended by inverse distance. Every point then gets its height above its bin's
-// plane (with blend_radial: that plane interpolated with the fitted plane of the bin beyond it on the point's
-// side, inwards or outwards, by distance from the point to where each was fitted), is ground below
-// ground_threshold_m, and is flagged `guessed` where its bin's ground lies farther than
+// building do not), and, with max_below_m, none of the bin's own points more than that below it (the ground is
+// the lower envelope: behind a tree row the next row's crowns give a flat "ground" of horizontal-laser returns
+// with a lower laser's return under it). Otherwise it continues the prior's plane. Once every bin is done, a
+// bin without its own plane gets the planes around it (continued from inside, the first fitted bin outside it,
+// the nearest fitted ones either side in its ring) blended by inverse distance. Every point then gets its
+// height above its bin's plane (with blend_radial: that plane interpolated with the fitted plane of the bin
+// beyond it on the point's side, inwards or outwards, by distance from the point to where each was fitted),
+// is ground below ground_threshold_m, and is flagged `guessed` where its bin's ground lies farther than
 // max_extrapolation_m from any measured ground. The surface is kept: ground_z(x, y) answers for any (x, y).
 // Thread-compatible.
 

@@ -1,0 +1,220 @@
+#include "fieldguard/perception/cluster_split.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace fieldguard::perception {
+
+namespace {
+
+// A part also needs this share of the cluster's points, and never fewer than kMinPartPoints: a handful of stray
+// returns at one end of a crown is not a second crown.
+constexpr double kMinPartShare = 0.1;
+constexpr std::size_t kMinPartPoints = 3;
+// Slots along a cluster's axis at most: 4096 slots of 0.24 m (the narrowest gap fieldguard.yaml's radius and the
+// ratio 0.6 can count) span 980 m; a longer cluster gets wider slots, and a narrower gap inside one goes unseen.
+constexpr std::size_t kMaxSlots = 4096;
+
+void check(double v, const char* what) {
+  if (!(v >= 0.0) || !std::isfinite(v)) {
+    throw std::invalid_argument(std::string("ClusterSplitter: ") + what + " must be finite and not negative");
+  }
+}
+
+}  // namespace
+
+ClusterSplitter::ClusterSplitter(const ClusterSplitParams& params) : params_(params) {
+  check(params.min_length_m, "min_length_m");
+  check(params.min_part_m, "min_part_m");
+  if (params.min_part_points < 0) throw std::invalid_argument("ClusterSplitter: min_part_points must not be negative");
+  if (!(params.full_range_m > 0.0) || !std::isfinite(params.full_range_m)) {
+    throw std::invalid_argument("ClusterSplitter: full_range_m must be finite and positive");
+  }
+  // A ratio of 0 would count every gap between two returns.
+  if (!(params.gap_ratio > 0.0) || !std::isfinite(params.gap_ratio)) {
+    throw std::invalid_argument("ClusterSplitter: gap_ratio must be finite and positive");
+  }
+}
+
+bool ClusterSplitter::find_cut(const Cloud& cloud, const EuclideanClusterer& clusterer,
+                               std::span<const std::uint32_t> members, const Spread& sp, float& cut) {
+  const std::size_t m = members.size();
+  // The long axis: the principal axis of the x-y spread (moments about the first point: a cluster 40 m out spread
+  // over centimetres keeps its digits).
+  const double inv_m = 1.0 / static_cast<double>(m);
+  const double dmx = sp.sx * inv_m, dmy = sp.sy * inv_m;
+  const double sxx = sp.sxx * inv_m - dmx * dmx, sxy = sp.sxy * inv_m - dmx * dmy, syy = sp.syy * inv_m - dmy * dmy;
+  const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);
+  const auto ax = static_cast<float>(std::cos(angle)), ay = static_cast<float>(std::sin(angle));
+  const auto mx = static_cast<float>(sp.x0 + dmx), my = static_cast<float>(sp.y0 + dmy);
+  // The projections lie within those of the x-y box's corners.
+  float t_lo = std::numeric_limits<float>::max(), t_hi = std::numeric_limits<float>::lowest();
+  for (const float cx : {sp.lo[0], sp.hi[0]}) {
+    for (const float cy : {sp.lo[1], sp.hi[1]}) {
+      const float t = (cx - mx) * ax + (cy - my) * ay;
+      t_lo = std::min(t_lo, t);
+      t_hi = std::max(t_hi, t);
+    }
+  }
+  if (t_hi - t_lo < static_cast<float>(params_.min_length_m)) return false;
+
+  // Slots along the axis no wider than the narrowest gap that can count (no radius is below tolerance_m): two
+  // projections in one slot are never a gap, so the gaps between occupied slots are all the gaps there are
+  // between the sorted projections that could reach the ratio, found without sorting.
+  const auto ratio_min = static_cast<float>(params_.gap_ratio);
+  const float gap_floor = ratio_min * static_cast<float>(clusterer.params().tolerance_m);
+  const float width = std::max(gap_floor, (t_hi - t_lo) / static_cast<float>(kMaxSlots - 1));
+  const float inv_width = 1.F / width;
+  const auto slots = std::min<std::size_t>(kMaxSlots, static_cast<std::size_t>((t_hi - t_lo) * inv_width) + 1);
+  const auto last_slot = static_cast<float>(slots - 1);
+  slots_.assign(slots, Slot{0U, 0.F, 0.F, 0U, 0U});
+  t_.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::uint32_t i = members[k];
+    const float t = (cloud.x[i] - mx) * ax + (cloud.y[i] - my) * ay;
+    t_[k] = t;
+    const float q = std::clamp((t - t_lo) * inv_width, 0.F, last_slot);
+    Slot& slot = slots_[static_cast<std::size_t>(q)];
+    if (slot.count++ == 0) {
+      slot.lo = slot.hi = t;
+      slot.lo_i = slot.hi_i = i;
+    } else if (t < slot.lo) {
+      slot.lo = t;
+      slot.lo_i = i;
+    } else if (t > slot.hi) {
+      slot.hi = t;
+      slot.hi_i = i;
+    }
+  }
+  float front = 0.F, back = 0.F;
+  for (const Slot& slot : slots_) {
+    if (slot.count != 0) {
+      front = slot.lo;
+      break;
+    }
+  }
+  for (std::size_t s = slots; s-- > 0;) {
+    if (slots_[s].count != 0) {
+      back = slots_[s].hi;
+      break;
+    }
+  }
+  if (back - front < static_cast<float>(params_.min_length_m)) return false;
+
+  const auto min_part_m = static_cast<float>(params_.min_part_m);
+  const std::size_t share =
+      std::max(kMinPartPoints, static_cast<std::size_t>(std::ceil(kMinPartShare * static_cast<double>(m))));
+  const auto full = static_cast<float>(params_.full_range_m);
+  const auto part_points = static_cast<float>(params_.min_part_points);
+  const auto range_of = [&cloud](std::uint32_t i) {
+    return std::sqrt(cloud.x[i] * cloud.x[i] + cloud.y[i] * cloud.y[i] + cloud.z[i] * cloud.z[i]);
+  };
+  bool found = false;
+  float best_ratio = 0.F;
+  std::size_t before = 0;  // points up to the last occupied slot
+  const Slot* last = nullptr;
+  for (const Slot& slot : slots_) {
+    if (slot.count == 0) continue;
+    if (last != nullptr) {
+      const float gap = slot.lo - last->hi;
+      const std::size_t after = m - before;
+      if (gap >= gap_floor && before >= share && after >= share && last->hi - front >= min_part_m &&
+          back - slot.lo >= min_part_m) {
+        const float r = 0.5F * (range_of(last->hi_i) + range_of(slot.lo_i));
+        const float scale = r > full ? (full / r) * (full / r) : 1.F;
+        const auto need = static_cast<std::size_t>(std::ceil(part_points * scale));
+        const float ratio = gap / clusterer.horizontal_radius_at(r);
+        if (before >= need && after >= need && ratio >= ratio_min && ratio > best_ratio) {
+          best_ratio = ratio;
+          cut = 0.5F * (last->hi + slot.lo);
+          found = true;
+        }
+      }
+    }
+    before += slot.count;
+    last = &slot;
+  }
+  return found;
+}
+
+std::uint32_t ClusterSplitter::split(const Cloud& cloud, const EuclideanClusterer& clusterer, Clusters& clusters) {
+  const std::size_t nc = clusters.size();
+  if (!(params_.min_length_m > 0.0) || nc == 0) return 0;
+  const std::size_t n = cloud.size();
+  const auto min_len = static_cast<float>(params_.min_length_m);
+  for (const std::uint32_t i : clusters.indices) {
+    if (i >= n) throw std::out_of_range("ClusterSplitter: a cluster indexes a point past the cloud's end");
+  }
+  std::uint32_t cuts = 0;
+  parts_.clear();
+  pieces_.clear();
+  for (std::size_t c = 0; c < nc; ++c) {
+    const auto members = clusters[c];
+    if (members.size() < 2 * kMinPartPoints) continue;
+    // Its x-y box (whose diagonal bounds its extent along any axis: most clusters end here) and moments, in one pass.
+    Spread sp{
+        static_cast<double>(cloud.x[members[0]]),   static_cast<double>(cloud.y[members[0]]),  0.0, 0.0, 0.0, 0.0, 0.0,
+        {cloud.x[members[0]], cloud.y[members[0]]}, {cloud.x[members[0]], cloud.y[members[0]]}};
+    for (const std::uint32_t i : members) {
+      const float x = cloud.x[i], y = cloud.y[i];
+      sp.lo[0] = std::min(sp.lo[0], x);
+      sp.hi[0] = std::max(sp.hi[0], x);
+      sp.lo[1] = std::min(sp.lo[1], y);
+      sp.hi[1] = std::max(sp.hi[1], y);
+      const double dx = static_cast<double>(x) - sp.x0, dy = static_cast<double>(y) - sp.y0;
+      sp.sx += dx;
+      sp.sy += dy;
+      sp.sxx += dx * dx;
+      sp.sxy += dx * dy;
+      sp.syy += dy * dy;
+    }
+    if (std::hypot(sp.hi[0] - sp.lo[0], sp.hi[1] - sp.lo[1]) < min_len) continue;
+    float cut = 0.F;
+    if (!find_cut(cloud, clusterer, members, sp, cut)) continue;
+    // find_cut left each member's projection in t_: the part before the cut, then the rest, go to parts_.
+    const auto begin = static_cast<std::uint32_t>(parts_.size());
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      if (t_[k] < cut) parts_.push_back(members[k]);
+    }
+    const auto middle = static_cast<std::uint32_t>(parts_.size());
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      if (!(t_[k] < cut)) parts_.push_back(members[k]);
+    }
+    pieces_.push_back(Piece{static_cast<std::uint32_t>(c), begin, middle});
+    ++cuts;
+  }
+  if (cuts == 0) return 0;
+  // Rebuilt in the order of each cluster's lowest point index (members stay ascending: each part keeps its order).
+  // The clusters that were not cut keep theirs; each cut one gives two parts, placed by their first members.
+  order_.clear();
+  std::size_t next_cut = 0;
+  for (std::size_t c = 0; c < nc; ++c) {
+    if (next_cut < pieces_.size() && pieces_[next_cut].cluster == c) {
+      const Piece& p = pieces_[next_cut];
+      const std::uint32_t end =
+          next_cut + 1 < pieces_.size() ? pieces_[next_cut + 1].begin : static_cast<std::uint32_t>(parts_.size());
+      order_.push_back(Range{parts_[p.begin], true, p.begin, p.middle});
+      order_.push_back(Range{parts_[p.middle], true, p.middle, end});
+      ++next_cut;
+    } else if (clusters.offsets[c + 1] > clusters.offsets[c]) {
+      order_.push_back(
+          Range{clusters.indices[clusters.offsets[c]], false, clusters.offsets[c], clusters.offsets[c + 1]});
+    }  // an empty cluster is dropped, as the joiner drops them
+  }
+  std::stable_sort(order_.begin(), order_.end(), [](const Range& a, const Range& b) { return a.first < b.first; });
+  rebuilt_.indices.clear();
+  rebuilt_.offsets.clear();
+  rebuilt_.offsets.push_back(0U);
+  for (const Range& r : order_) {
+    const std::uint32_t* from = r.in_parts ? parts_.data() : clusters.indices.data();
+    rebuilt_.indices.insert(rebuilt_.indices.end(), from + r.begin, from + r.end);
+    rebuilt_.offsets.push_back(static_cast<std::uint32_t>(rebuilt_.indices.size()));
+  }
+  std::swap(clusters, rebuilt_);
+  return cuts;
+}
+
+}  // namespace fieldguard::perception
