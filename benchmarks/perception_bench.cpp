@@ -485,8 +485,7 @@ void BM_ClusterJoin(benchmark::State& state) {
   state.counters["joins"] = static_cast<double>(joined);
 }
 
-// The split of clusters holding two crowns (cluster_split.hpp; no PCL counterpart) with the candidate keys
-// (/work/scenes/cand-C3.yaml: examined from 2 m long; fieldguard.yaml leaves it off), on fieldguard.yaml's clusters
+// The split of clusters holding two crowns (cluster_split.hpp; no PCL counterpart), on fieldguard.yaml's clusters
 // after absorption and joins: the stage's cost is the clusters long enough to be looked at (the shed's walls).
 void BM_ClusterSplit(benchmark::State& state) {
   Frame& f = frame(static_cast<int>(state.range(0)));
@@ -501,9 +500,7 @@ void BM_ClusterSplit(benchmark::State& state) {
   std::vector<float> height(f.above.z.begin(), f.above.z.end());
   for (float& h : height) h += sensor_h;
   joiner.join(f.above, height, fieldguard_params().filters, clustered);
-  ClusterSplitParams sp = ClusterSplitParams::from(cp);
-  sp.min_length_m = 2.0;
-  ClusterSplitter splitter(sp);
+  ClusterSplitter splitter(ClusterSplitParams::from(cp));
   std::uint32_t cuts = 0;
   paired(state, "cluster split (two crowns)", static_cast<int>(state.range(0)), f.above.size(),
          [&] {

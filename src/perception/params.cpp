@@ -16,6 +16,8 @@ PipelineParams published_params() {
   p.cluster.structure = ClusterStructure::KdTree;
   p.cluster.tolerance_m = 0.6;
   p.cluster.absorb_max_points = 0;
+  p.cluster.join_float_height_m = 0.0;
+  p.cluster.split_min_length_m = 0.0;
   p.filters.min_points = 10;
   p.filters.max_points = 240;
   p.filters.min_volume_m3 = 0.06;

@@ -53,6 +53,8 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_DOUBLE_EQ(p.filters.min_height_m, 0.0);
   EXPECT_DOUBLE_EQ(p.filters.min_points_full_range_m, 0.0);
   EXPECT_EQ(p.cluster.absorb_max_points, 0);
+  EXPECT_EQ(p.cluster.join_float_height_m, 0.0);
+  EXPECT_EQ(p.cluster.split_min_length_m, 0.0);
   EXPECT_FALSE(p.near_field.enabled);  // the published method had no 2D LiDAR
   // And it is what the perception module calls the published method.
   const auto pub = perception::published_params();
@@ -60,6 +62,8 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.ground.ransac.iterations, pub.ground.ransac.iterations);
   EXPECT_EQ(p.cluster.method, pub.cluster.method);
   EXPECT_EQ(p.cluster.absorb_max_points, pub.cluster.absorb_max_points);
+  EXPECT_EQ(p.cluster.join_float_height_m, pub.cluster.join_float_height_m);
+  EXPECT_EQ(p.cluster.split_min_length_m, pub.cluster.split_min_length_m);
   EXPECT_EQ(p.filters.max_points, pub.filters.max_points);
   EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, pub.filters.min_volume_m3);
   EXPECT_EQ(p.near_field.enabled, pub.near_field.enabled);
@@ -128,6 +132,11 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.cluster.join_gap_m, d.cluster.join_gap_m);
   EXPECT_EQ(p.cluster.join_stacked, d.cluster.join_stacked);
   EXPECT_EQ(p.cluster.join_stack_margin_m, d.cluster.join_stack_margin_m);
+  EXPECT_EQ(p.cluster.split_min_length_m, d.cluster.split_min_length_m);
+  EXPECT_EQ(p.cluster.split_min_part_m, d.cluster.split_min_part_m);
+  EXPECT_EQ(p.cluster.split_gap_ratio, d.cluster.split_gap_ratio);
+  EXPECT_EQ(p.cluster.split_min_part_points, d.cluster.split_min_part_points);
+  EXPECT_EQ(p.cluster.split_full_range_m, d.cluster.split_full_range_m);
   EXPECT_EQ(p.filters.min_points, d.filters.min_points);
   EXPECT_EQ(p.filters.max_points, d.filters.max_points);
   EXPECT_EQ(p.filters.min_volume_m3, d.filters.min_volume_m3);
@@ -589,14 +598,14 @@ TEST(ConfigLoad, ReadsTheGroundContext) {
   EXPECT_EQ(published.config.perception.ground.context_m, 0.0);
 }
 
-// The zone ground's lower-envelope rule (zone_ground.hpp): read; left out, off.
+// The zone ground's lower-envelope rule (zone_ground.hpp): read; left out, fieldguard.yaml's value.
 TEST(ConfigLoad, ReadsTheGroundMaxBelowKey) {
   const auto r = load_config_text("perception: {ground: {zones: {max_below_m: 0.3}}}\n", "t.yaml");
   ASSERT_TRUE(r.ok()) << dump(r);
   EXPECT_DOUBLE_EQ(r.config.perception.ground.zones.max_below_m, 0.3);
   const auto d = load_config_text("perception: {}\n", "t.yaml");
   ASSERT_TRUE(d.ok()) << dump(d);
-  EXPECT_EQ(d.config.perception.ground.zones.max_below_m, 0.0);
+  EXPECT_EQ(d.config.perception.ground.zones.max_below_m, 0.3);  // left out: fieldguard.yaml's value
 }
 
 TEST(ConfigLoad, ReportsABadGroundMaxBelow) {
@@ -610,7 +619,8 @@ TEST(ConfigLoad, ReportsABadGroundMaxBelow) {
   }
 }
 
-// The split of clusters holding two crowns (cluster_split.hpp): read; left out, off; bad values reported.
+// The split of clusters holding two crowns (cluster_split.hpp): read; left out, fieldguard.yaml's values; bad
+// values reported.
 TEST(ConfigLoad, ReadsAndChecksTheClusterSplitKeys) {
   const auto r = load_config_text(R"(
 perception:
@@ -627,7 +637,7 @@ perception:
   EXPECT_DOUBLE_EQ(c.split_full_range_m, 12.0);
   const auto d = load_config_text("perception:\n  cluster: {method: anisotropic}\n", "d.yaml");
   ASSERT_TRUE(d.ok()) << dump(d);
-  EXPECT_EQ(d.config.perception.cluster.split_min_length_m, 0.0);  // off unless asked for
+  EXPECT_EQ(d.config.perception.cluster.split_min_length_m, 2.0);  // left out: fieldguard.yaml's value
 
   const std::string text =
       "perception:\n"                         // 1

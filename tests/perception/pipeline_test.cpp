@@ -170,7 +170,9 @@ TEST(Pipeline, GroundBeyondTheRegionOfInterestIsContextOnly) {
   std::size_t in_roi = 0;
   for (const LidarPoint& p : pts) in_roi += p.x <= 50.F ? 1U : 0U;
 
-  PipelineParams without;
+  PipelineParams base;
+  base.roi.max[0] = 50.0;  // the scene is laid out around a region ending at 50 m
+  PipelineParams without = base;
   without.ground.context_m = 0.0;
   const FrameResult cut = Pipeline(without).process(pts);
   ASSERT_EQ(cut.obstacles.size(), 1U) << "the clod against the flat ground carried on";
@@ -178,7 +180,7 @@ TEST(Pipeline, GroundBeyondTheRegionOfInterestIsContextOnly) {
   EXPECT_GT(cut.obstacles[0].height_above_ground_m, 0.8F);
   EXPECT_EQ(cut.counts.after_roi, in_roi);
 
-  PipelineParams with;
+  PipelineParams with = base;
   with.ground.context_m = 15.0;
   const FrameResult seen = Pipeline(with).process(pts);
   EXPECT_TRUE(seen.obstacles.empty()) << "nearest: " << (seen.obstacles.empty() ? 0.F : seen.obstacles[0].distance_m)

@@ -229,6 +229,7 @@ TEST(ZoneGround, APlaneWithItsOwnReturnsFarBelowItIsNotGround) {
   const float cx = 29.F * std::cos(14.F * deg), cy = 29.F * std::sin(14.F * deg);
 
   ZoneParams zp;
+  zp.max_below_m = 0.0;  // the rule off
   GroundLabels today, fixed;
   ZoneGround plain(zp);
   plain.segment(c, today);
@@ -268,6 +269,7 @@ TEST(ZoneGround, TheLowerEnvelopeRuleLeavesRealGroundAlone) {
   for (const auto& scene : scenes) {
     const Cloud c = prepared(scene);
     ZoneParams zp;
+    zp.max_below_m = 0.0;  // the rule off
     GroundLabels off, on;
     ZoneGround(zp).segment(c, off);
     zp.max_below_m = 0.3;

@@ -71,7 +71,7 @@ struct ZoneParams {
   // The ground is the lower envelope of its bin's returns: a bin with a return of its own more than this below its
   // fitted plane keeps the plane continued from inside (m; 0 = off). Behind a tree row only the near-horizontal
   // lasers reach the next row's crowns; a plane fitted to their returns has a lower laser's crown return under it.
-  double max_below_m = 0.0;
+  double max_below_m = 0.3;
   double sensor_height_m = 0.95;  // the LiDAR above flat ground; the loader copies lidar.mounting.z_m
 };
 
@@ -124,7 +124,7 @@ struct ClusterParams {
   // widest empty slot across it that is at least split_gap_ratio times the horizontal radius there, when each part is
   // at least split_min_part_m long with split_min_part_points points (falling as (split_full_range_m / r)^2 beyond
   // split_full_range_m): two crowns side by side. split_min_length_m 0 = off.
-  double split_min_length_m = 0.0;
+  double split_min_length_m = 2.0;
   double split_min_part_m = 0.5;
   double split_gap_ratio = 0.6;
   int split_min_part_points = 40;
@@ -196,7 +196,7 @@ struct NearFieldParams {
 
 struct PipelineParams {
   VoxelParams voxel;
-  Box3 roi{{-10.0, -10.0, -6.0}, {50.0, 10.0, 6.0}};
+  Box3 roi{{-10.0, -10.0, -6.0}, {52.0, 10.0, 6.0}};
   Box3 body{{-5.0, -1.5, -1.5}, {0.4, 1.5, 1.5}};
   GroundParams ground;
   ClusterParams cluster;
