@@ -458,20 +458,36 @@ void BM_PipelinePublished(benchmark::State& state) { pipeline_bench(state, "PIPE
 void BM_PipelineFieldguard(benchmark::State& state) {
   pipeline_bench(state, "PIPELINE fieldguard.yaml", fieldguard_params());
 }
+
+// fieldguard.yaml's clusters of a frame's above-ground points after absorption, and the points' heights above a
+// level ground at the sensor's mounting height: the input of the stages after absorption.
+struct AbsorbedClusters {
+  Clusters clusters;
+  std::vector<float> height;
+};
+AbsorbedClusters absorbed_clusters(const Frame& f) {
+  const ClusterParams& cp = fieldguard_params().cluster;
+  EuclideanClusterer clusterer(cp);
+  ClusterAbsorber absorber(cp.absorb_max_points, cp.absorb_margin_m);
+  AbsorbedClusters out;
+  clusterer.extract(f.above, out.clusters);
+  absorber.absorb(f.above, out.clusters);
+  const auto sensor_h = static_cast<float>(fieldguard_params().ground.zones.sensor_height_m);
+  out.height.assign(f.above.z.begin(), f.above.z.end());
+  for (float& h : out.height) h += sensor_h;
+  return out;
+}
+
 // The floating-cluster joins (cluster_join.hpp; no PCL counterpart) with fieldguard.yaml's keys, on its clusters
 // after absorption. Heights above a level ground at the sensor's mounting height: the stage's cost is its pairs of
 // clusters, whatever the heights make of them.
 void BM_ClusterJoin(benchmark::State& state) {
   Frame& f = frame(static_cast<int>(state.range(0)));
   const ClusterParams& cp = fieldguard_params().cluster;
-  EuclideanClusterer clusterer(cp);
-  ClusterAbsorber absorber(cp.absorb_max_points, cp.absorb_margin_m);
-  Clusters clustered, work;
-  clusterer.extract(f.above, clustered);
-  absorber.absorb(f.above, clustered);
-  const auto sensor_h = static_cast<float>(fieldguard_params().ground.zones.sensor_height_m);
-  std::vector<float> height(f.above.z.begin(), f.above.z.end());
-  for (float& h : height) h += sensor_h;
+  const AbsorbedClusters in = absorbed_clusters(f);
+  const Clusters& clustered = in.clusters;
+  const std::vector<float>& height = in.height;
+  Clusters work;
   ClusterJoiner joiner(ClusterJoinParams::from(cp));
   std::uint32_t joined = 0;
   paired(state, "cluster join (floating)", static_cast<int>(state.range(0)), f.above.size(),
@@ -490,16 +506,11 @@ void BM_ClusterJoin(benchmark::State& state) {
 void BM_ClusterSplit(benchmark::State& state) {
   Frame& f = frame(static_cast<int>(state.range(0)));
   const ClusterParams& cp = fieldguard_params().cluster;
-  EuclideanClusterer clusterer(cp);
-  ClusterAbsorber absorber(cp.absorb_max_points, cp.absorb_margin_m);
-  ClusterJoiner joiner(ClusterJoinParams::from(cp));
-  Clusters clustered, work;
-  clusterer.extract(f.above, clustered);
-  absorber.absorb(f.above, clustered);
-  const auto sensor_h = static_cast<float>(fieldguard_params().ground.zones.sensor_height_m);
-  std::vector<float> height(f.above.z.begin(), f.above.z.end());
-  for (float& h : height) h += sensor_h;
-  joiner.join(f.above, height, fieldguard_params().filters, clustered);
+  AbsorbedClusters in = absorbed_clusters(f);
+  Clusters& clustered = in.clusters;
+  ClusterJoiner(ClusterJoinParams::from(cp)).join(f.above, in.height, fieldguard_params().filters, clustered);
+  EuclideanClusterer clusterer(cp);  // the split measures gaps against its horizontal radius
+  Clusters work;
   ClusterSplitter splitter(ClusterSplitParams::from(cp));
   std::uint32_t cuts = 0;
   paired(state, "cluster split (two crowns)", static_cast<int>(state.range(0)), f.above.size(),

@@ -66,13 +66,8 @@ std::vector<std::uint32_t> range(std::uint32_t from, std::uint32_t to) {
   return v;
 }
 
-TEST(ClusterSplitter, TwoCrownsTheClustererJoinedAreCutApart) {
-  // Two crowns 0.3 m apart in a row along x, 8 m out: their tips (lattice points) are 0.3 m apart, nearer than
-  // the clusterer's 0.4 m, so it makes them one.
-  Cloud c;
-  add_crown(c, {6.F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F});
-  const auto first = static_cast<std::uint32_t>(c.size());
-  add_crown(c, {8.4F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F});
+// `c` is two crowns, its points [0, first) and [first, end): the clusterer joins them, the split cuts them apart.
+void expect_cut_apart(const Cloud& c, std::uint32_t first) {
   const auto all = static_cast<std::uint32_t>(c.size());
   Clusters k = cluster(c);
   ASSERT_EQ(k.size(), 1U) << "the clusterer must join the two for this test to mean anything";
@@ -80,6 +75,16 @@ TEST(ClusterSplitter, TwoCrownsTheClustererJoinedAreCutApart) {
   ClusterSplitter s(split_params());
   EXPECT_EQ(s.split(c, clusterer, k), 1U);
   EXPECT_EQ(sets_of(k), (Sets{range(0, first), range(first, all)}));
+}
+
+TEST(ClusterSplitter, TwoCrownsTheClustererJoinedAreCutApart) {
+  // Two crowns 0.3 m apart in a row along x, 8 m out: their tips (lattice points) are 0.3 m apart, nearer than
+  // the clusterer's 0.4 m, so it makes them one.
+  Cloud c;
+  add_crown(c, {6.F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F});
+  const auto first = static_cast<std::uint32_t>(c.size());
+  add_crown(c, {8.4F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F});
+  expect_cut_apart(c, first);
 }
 
 TEST(ClusterSplitter, TwoFarCrownsWithFewReturnsAreCutApart) {
@@ -91,13 +96,7 @@ TEST(ClusterSplitter, TwoFarCrownsWithFewReturnsAreCutApart) {
   add_crown(c, {28.F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F}, 0.2F, &rng, 0.3F);
   const auto first = static_cast<std::uint32_t>(c.size());
   add_crown(c, {30.55F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F}, 0.2F, &rng, 0.3F);
-  const auto all = static_cast<std::uint32_t>(c.size());
-  Clusters k = cluster(c);
-  ASSERT_EQ(k.size(), 1U);
-  EuclideanClusterer clusterer(cluster_params());
-  ClusterSplitter s(split_params());
-  EXPECT_EQ(s.split(c, clusterer, k), 1U);
-  EXPECT_EQ(sets_of(k), (Sets{range(0, first), range(first, all)}));
+  expect_cut_apart(c, first);
 }
 
 TEST(ClusterSplitter, APorousCrownStaysWhole) {
