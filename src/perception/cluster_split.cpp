@@ -17,6 +17,7 @@ constexpr std::size_t kMinPartPoints = 3;
 // Slots along a cluster's axis at most: 4096 slots of 0.24 m (the narrowest gap fieldguard.yaml's radius and the
 // ratio 0.6 can count) span 980 m; a longer cluster gets wider slots, and a narrower gap inside one goes unseen.
 constexpr std::size_t kMaxSlots = 4096;
+constexpr std::uint32_t kNone = 0xFFFFFFFFU;  // a point in no cluster
 
 void check(double v, const char* what) {
   if (!(v >= 0.0) || !std::isfinite(v)) {
@@ -149,8 +150,6 @@ std::uint32_t ClusterSplitter::split(const Cloud& cloud, const EuclideanClustere
     if (i >= n) throw std::out_of_range("ClusterSplitter: a cluster indexes a point past the cloud's end");
   }
   std::uint32_t cuts = 0;
-  parts_.clear();
-  pieces_.clear();
   for (std::size_t c = 0; c < nc; ++c) {
     const auto members = clusters[c];
     if (members.size() < 2 * kMinPartPoints) continue;
@@ -174,46 +173,23 @@ std::uint32_t ClusterSplitter::split(const Cloud& cloud, const EuclideanClustere
     if (std::hypot(sp.hi[0] - sp.lo[0], sp.hi[1] - sp.lo[1]) < min_len) continue;
     float cut = 0.F;
     if (!find_cut(cloud, clusterer, members, sp, cut)) continue;
-    // find_cut left each member's projection in t_: the part before the cut, then the rest, go to parts_.
-    const auto begin = static_cast<std::uint32_t>(parts_.size());
-    for (std::size_t k = 0; k < members.size(); ++k) {
-      if (t_[k] < cut) parts_.push_back(members[k]);
+    if (cuts == 0) {  // the first cut: every point labelled with its cluster
+      of_point_.assign(n, kNone);
+      for (std::size_t d = 0; d < nc; ++d) {
+        for (const std::uint32_t i : clusters[d]) of_point_[i] = static_cast<std::uint32_t>(d);
+      }
     }
-    const auto middle = static_cast<std::uint32_t>(parts_.size());
+    // find_cut left each member's projection in t_: the part beyond the cut becomes a cluster of its own.
+    const auto beyond = static_cast<std::uint32_t>(nc + cuts);
     for (std::size_t k = 0; k < members.size(); ++k) {
-      if (!(t_[k] < cut)) parts_.push_back(members[k]);
+      if (!(t_[k] < cut)) of_point_[members[k]] = beyond;
     }
-    pieces_.push_back(Piece{static_cast<std::uint32_t>(c), begin, middle});
     ++cuts;
   }
   if (cuts == 0) return 0;
-  // Rebuilt in the order of each cluster's lowest point index (members stay ascending: each part keeps its order).
-  // The clusters that were not cut keep theirs; each cut one gives two parts, placed by their first members.
-  order_.clear();
-  std::size_t next_cut = 0;
-  for (std::size_t c = 0; c < nc; ++c) {
-    if (next_cut < pieces_.size() && pieces_[next_cut].cluster == c) {
-      const Piece& p = pieces_[next_cut];
-      const std::uint32_t end =
-          next_cut + 1 < pieces_.size() ? pieces_[next_cut + 1].begin : static_cast<std::uint32_t>(parts_.size());
-      order_.push_back(Range{parts_[p.begin], true, p.begin, p.middle});
-      order_.push_back(Range{parts_[p.middle], true, p.middle, end});
-      ++next_cut;
-    } else if (clusters.offsets[c + 1] > clusters.offsets[c]) {
-      order_.push_back(
-          Range{clusters.indices[clusters.offsets[c]], false, clusters.offsets[c], clusters.offsets[c + 1]});
-    }  // an empty cluster is dropped, as the joiner drops them
-  }
-  std::stable_sort(order_.begin(), order_.end(), [](const Range& a, const Range& b) { return a.first < b.first; });
-  rebuilt_.indices.clear();
-  rebuilt_.offsets.clear();
-  rebuilt_.offsets.push_back(0U);
-  for (const Range& r : order_) {
-    const std::uint32_t* from = r.in_parts ? parts_.data() : clusters.indices.data();
-    rebuilt_.indices.insert(rebuilt_.indices.end(), from + r.begin, from + r.end);
-    rebuilt_.offsets.push_back(static_cast<std::uint32_t>(rebuilt_.indices.size()));
-  }
-  std::swap(clusters, rebuilt_);
+  // Rebuilt as the clusterer orders its clusters (by each one's lowest point index, members ascending); an empty
+  // cluster is dropped, as the joiner drops them.
+  group_by_first_point(of_point_, static_cast<std::uint32_t>(nc + cuts), kNone, clusters, id_, scratch_);
   return cuts;
 }
 

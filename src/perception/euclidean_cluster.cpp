@@ -532,16 +532,20 @@ void merge_clusters(std::span<const std::uint32_t> target, std::size_t points, C
   for (std::size_t c = 0; c < nc; ++c) {
     for (const std::uint32_t i : clusters[c]) of_point[i] = target[c];
   }
-  // Numbered by first appearance in point order: the order of each merged cluster's lowest point index.
-  id.assign(nc, kNone);
-  std::uint32_t out_clusters = 0;
-  for (std::size_t i = 0; i < points; ++i) {
-    if (of_point[i] == kNone) continue;
-    std::uint32_t& k = id[of_point[i]];
-    if (k == kNone) k = out_clusters++;
-    of_point[i] = k;
+  group_by_first_point(of_point, static_cast<std::uint32_t>(nc), kNone, clusters, id, scratch);
+}
+
+void group_by_first_point(Buffer<std::uint32_t>& of_point, std::uint32_t labels, std::uint32_t none, Clusters& out,
+                          Buffer<std::uint32_t>& id, Buffer<std::uint32_t>& scratch) {
+  id.assign(labels, none);
+  std::uint32_t count = 0;
+  for (std::uint32_t& label : of_point) {
+    if (label == none) continue;
+    std::uint32_t& k = id[label];
+    if (k == none) k = count++;
+    label = k;
   }
-  group_points({of_point.data(), points}, out_clusters, kNone, clusters, scratch);
+  group_points({of_point.data(), of_point.size()}, count, none, out, scratch);
 }
 
 }  // namespace fieldguard::perception

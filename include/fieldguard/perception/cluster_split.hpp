@@ -74,18 +74,7 @@ class ClusterSplitter {
   };
   Buffer<float> t_;  // per member of the cluster looked at: its projection on the long axis
   Buffer<Slot> slots_;
-  struct Piece {  // a cut cluster: its first part is parts_[begin, middle), its second from middle on
-    std::uint32_t cluster, begin, middle;
-  };
-  struct Range {          // a cluster of the output: [begin, end) of parts_ (in_parts) or of the input's indices
-    std::uint32_t first;  // its lowest point index
-    bool in_parts;
-    std::uint32_t begin, end;
-  };
-  Buffer<std::uint32_t> parts_;
-  Buffer<Piece> pieces_;
-  Buffer<Range> order_;
-  Clusters rebuilt_;
+  Buffer<std::uint32_t> of_point_, id_, scratch_;  // each point's cluster after the cuts; group_by_first_point's
 };
 
 }  // namespace fieldguard::perception

@@ -39,9 +39,15 @@ struct Clusters {
 void group_points(std::span<const std::uint32_t> cluster_of_point, std::uint32_t count, std::uint32_t none,
                   Clusters& out, Buffer<std::uint32_t>& scratch);
 
+// Clusters from each point's label (any number below `labels`, or `none`: in no cluster), numbered by first
+// appearance in point order: the clusters in the order of each one's lowest point index, members ascending, a
+// label no point carries left out. `of_point` is renumbered on the way; `id` and `scratch` are reused.
+void group_by_first_point(Buffer<std::uint32_t>& of_point, std::uint32_t labels, std::uint32_t none, Clusters& out,
+                          Buffer<std::uint32_t>& id, Buffer<std::uint32_t>& scratch);
+
 // Clusters merged in place: cluster c's points go to cluster target[c] (a cluster that is its own target), then
-// the clusters are rebuilt in the order of each one's lowest point index, members ascending (points of a cloud of
-// `points` in no cluster stay in none). The three buffers are scratch, reused.
+// the clusters are rebuilt by group_by_first_point (points of a cloud of `points` in no cluster stay in none). The
+// three buffers are scratch, reused.
 void merge_clusters(std::span<const std::uint32_t> target, std::size_t points, Clusters& clusters,
                     Buffer<std::uint32_t>& of_point, Buffer<std::uint32_t>& id, Buffer<std::uint32_t>& scratch);
 
