@@ -36,15 +36,33 @@ inline unsigned mask_bits(i32x4 m) {
 #endif
 }
 
-// floor(v) as int, v first clamped to [-limit, limit] (NaN to -limit): conversion never sees a value an int
-// cannot hold. As std::floor for every float in range: truncate, then one less where that rounded up.
-inline i32x4 floor_clamped(f32x4 v, float limit) {
-  const f32x4 lo = splat(-limit), hi = splat(limit);
-  v = v >= lo ? v : lo;
-  v = v <= hi ? v : hi;
+// v > lo ? v : lo and v < hi ? v : hi, lane by lane (NaN gives the bound): SSE2's maxps and minps exactly.
+// g++ does not always find them in the vector-extension form (a compare and three logic operations).
+inline f32x4 max_or_bound(f32x4 v, f32x4 lo) {
+#if defined(__SSE2__)
+  return _mm_max_ps(v, lo);
+#else
+  return v > lo ? v : lo;
+#endif
+}
+inline f32x4 min_or_bound(f32x4 v, f32x4 hi) {
+#if defined(__SSE2__)
+  return _mm_min_ps(v, hi);
+#else
+  return v < hi ? v : hi;
+#endif
+}
+
+// floor(v) as int, v first clamped to [lo, hi] (NaN to lo): conversion never sees a value an int cannot
+// hold. As std::floor for every float in range: truncate, then one less where that rounded up. The clamps
+// are strict comparisons (maxps, minps): they differ from >= and <= only where v equals the bound, a value
+// (and a floor) both return.
+inline i32x4 floor_clamped(f32x4 v, f32x4 lo, f32x4 hi) {
+  v = min_or_bound(max_or_bound(v, lo), hi);
   const i32x4 t = __builtin_convertvector(v, i32x4);
   return t + (v < __builtin_convertvector(t, f32x4));  // a true lane is -1
 }
+inline i32x4 floor_clamped(f32x4 v, float limit) { return floor_clamped(v, splat(-limit), splat(limit)); }
 
 using vec4::transpose4;
 

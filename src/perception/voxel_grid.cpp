@@ -32,15 +32,20 @@ inline std::uint64_t pack(std::int32_t ix, std::int32_t iy, std::int32_t iz, std
          (static_cast<std::uint64_t>(iy + kCoordOffset) << 20U) | static_cast<std::uint64_t>(iz + kCoordOffset);
 }
 
-constexpr std::size_t kBlock = 8;  // points whose keys are computed together
+constexpr std::size_t kBlock = 16;  // points whose keys are computed together
 
-// Keys of kBlock points with one leaf (inverse `s`), four at a time, clamped to the key's range.
-inline void block_keys(const float* x, const float* y, const float* z, float s, std::uint64_t* keys) {
-  const simd::f32x4 sv = simd::splat(s);
+// The constants of block_keys(), splatted once per frame rather than once per block.
+struct KeyLanes {
+  simd::f32x4 inv_leaf, lo, hi;
+  explicit KeyLanes(float s) : inv_leaf(simd::splat(s)), lo(simd::splat(-kCoordLimit)), hi(simd::splat(kCoordLimit)) {}
+};
+
+// Keys of kBlock points with one leaf, four at a time, clamped to the key's range.
+inline void block_keys(const float* x, const float* y, const float* z, const KeyLanes& c, std::uint64_t* keys) {
   for (std::size_t b = 0; b < kBlock; b += 4) {
-    const simd::i32x4 ix = simd::floor_clamped(simd::load(x + b) * sv, kCoordLimit);
-    const simd::i32x4 iy = simd::floor_clamped(simd::load(y + b) * sv, kCoordLimit);
-    const simd::i32x4 iz = simd::floor_clamped(simd::load(z + b) * sv, kCoordLimit);
+    const simd::i32x4 ix = simd::floor_clamped(simd::load(x + b) * c.inv_leaf, c.lo, c.hi);
+    const simd::i32x4 iy = simd::floor_clamped(simd::load(y + b) * c.inv_leaf, c.lo, c.hi);
+    const simd::i32x4 iz = simd::floor_clamped(simd::load(z + b) * c.inv_leaf, c.lo, c.hi);
     if constexpr (std::endian::native == std::endian::little) {
       // pack(x, y, z, 1) four at a time: the keys' low and high 32-bit halves, interleaved into 64 bits.
       using u32x4 = std::uint32_t __attribute__((vector_size(16)));
@@ -141,15 +146,15 @@ void VoxelGrid::begin(std::size_t max_points) {
   queued_ = 0;
 }
 
-// One point into the voxel `key`: into its ring's cache entry while the ring stays in one voxel. When it
+// One point into the voxel `key`: into its ring's cache entry `c` while the ring stays in one voxel. When it
 // moves on, the finished run (key, sums, count) is queued; queued runs meet the table in batches.
 // `queued` is the caller's copy of queued_, in a register: as a member, every point would load and store it
 // (the runs' 32-bit stores may alias it), a store-to-load chain through memory from one point to the next.
-inline void VoxelGrid::add(std::uint64_t key, std::uint32_t ring, simd::f32x4 p, std::uint32_t& queued) {
-  CacheEntry& c = cache_[ring & (kRingCache - 1)];
-  // Branching on whether the ring stays in its voxel (85 % of points do) measured 3-7 % faster than writing
-  // the entry's run to the queue on every point (BM_Voxel, g++ -O2, x86-64, one run on a busy machine). The new
-  // run starts from +0 + p, as a sum from zero does (a -0 coordinate becomes +0).
+inline void VoxelGrid::add(std::uint64_t key, CacheEntry& c, simd::f32x4 p, std::uint32_t& queued) {
+  // Branching on whether the ring stays in its voxel (72 % of the points of BM_Voxel's "shed 5Hz") measured
+  // 3-7 % faster than writing the entry's run to the queue on every point (BM_Voxel, g++ -O2, x86-64, busy
+  // machine; twice, in two sessions), mispredictions and all. The new run starts from +0 + p, as a sum from
+  // zero does (a -0 coordinate becomes +0).
   if (c.key == key) {
     c.sum = c.sum + p;  // lanes x, y, z (the fourth is not used)
     ++c.n;
@@ -171,70 +176,78 @@ inline void VoxelGrid::add(std::uint64_t key, std::uint32_t ring, simd::f32x4 p,
   }
 }
 
-inline void VoxelGrid::queue_run(const CacheEntry& c) {
-  runs_[queued_++] = Run{c.sum, c.key, c.n, 0};
-  if (queued_ == kRunBatch) drain_runs();
-}
-
 // The queued runs into their voxels, in queue order (so the voxel ids, and the output order, depend only on
-// the input). Two passes, each fetching a few runs ahead: the table slots, then the voxels' sums. A run's
-// lookup would otherwise wait on memory while nothing else can go on. The table's state is read into locals
-// once: as members, each would be loaded again after every 32-bit store to the table or a sum (may alias).
+// the input). First every run's table slot, fetched ahead: the lookups below then rarely wait on memory. One
+// pass after that: a new voxel (half the runs of BM_Voxel's "shed 5Hz") takes its run's sums as they are,
+// without a second pass that adds them to zeros. Measured slower on this machine (BM_Voxel, busy): telling new
+// from known voxels without a branch (masked sums), and fetching a known voxel's key and sums ahead.
+// The table's state is read into locals once: as members, each would be loaded again after every 32-bit store
+// to the table or a sum (may alias).
 void VoxelGrid::drain_runs() {
-  constexpr std::uint32_t kAhead = 6;
   const std::uint32_t queued = queued_;
+  Run* const runs = runs_.data();
   std::uint32_t* table = table_.data();
   std::uint32_t mask = mask_;
   std::uint32_t shift = shift_;
   std::uint32_t base = base_;
   std::uint32_t voxels = voxels_;
+  // At most a quarter of the table taken: a third of the lookups met another voxel's slot at half full;
+  // measured 5 % faster (BM_Voxel "shed 5Hz") for a table of 256 kB there.
+  auto limit = static_cast<std::uint32_t>(table_.size() / 4);
   std::uint64_t* const keys = keys_.data();
   Sum* const sums = sums_.data();
   for (std::uint32_t j = 0; j < queued; ++j) {
-    if (j + kAhead < queued) __builtin_prefetch(&table[slot_of(runs_[j + kAhead].key, shift)]);
-    Run& r = runs_[j];
+    runs[j].id = slot_of(runs[j].key, shift);
+    __builtin_prefetch(&table[runs[j].id]);
+  }
+  for (std::uint32_t j = 0; j < queued; ++j) {
+    const Run& r = runs[j];
     const std::uint64_t key = r.key;
-    std::uint32_t h = slot_of(key, shift);
-    std::uint32_t id = 0;
+    std::uint32_t h = r.id;  // the slot, from above
     for (;;) {
-      id = table[h] - base;
-      if (id >= voxels) break;  // empty in this frame
-      if (keys[id] == key) break;
+      const std::uint32_t id = table[h] - base;
+      if (id >= voxels) {  // empty in this frame: a new voxel
+        // Its sums are the run's: the same bits as adding them to zero, since a run's sum is never -0 (it
+        // starts from +0 + p, and x + y is -0 only when both are).
+        const std::uint32_t v = voxels++;
+        keys[v] = key;
+        static_assert(sizeof(Sum) == sizeof(Vec4));
+        std::memcpy(&sums[v], &r.sum, sizeof(Sum));
+        sums[v].n = r.n;
+        if (voxels > limit) [[unlikely]] {
+          voxels_ = voxels;
+          grow_table();  // re-inserts every key, this one included
+          table = table_.data();
+          mask = mask_;
+          shift = shift_;
+          base = base_;
+          limit = static_cast<std::uint32_t>(table_.size() / 4);
+          for (std::uint32_t k = j + 1; k < queued; ++k) runs[k].id = slot_of(runs[k].key, shift);  // new size
+        } else {
+          table[h] = base + v;
+        }
+        break;
+      }
+      if (keys[id] == key) {
+        Sum& a = sums[id];
+        a.x += r.sum[0];
+        a.y += r.sum[1];
+        a.z += r.sum[2];
+        a.n += r.n;
+        break;
+      }
       h = (h + 1) & mask;
     }
-    if (id >= voxels) {  // a new voxel
-      id = voxels++;
-      keys[id] = key;
-      sums[id] = Sum{0.F, 0.F, 0.F, 0};
-      if (static_cast<std::size_t>(voxels) * 2 > table_.size()) [[unlikely]] {
-        voxels_ = voxels;
-        grow_table();  // re-inserts every key, this one included
-        table = table_.data();
-        mask = mask_;
-        shift = shift_;
-        base = base_;
-      } else {
-        table[h] = base + id;
-      }
-    }
-    r.id = id;
   }
   voxels_ = voxels;
-  for (std::uint32_t j = 0; j < queued; ++j) {
-    if (j + kAhead < queued) __builtin_prefetch(&sums[runs_[j + kAhead].id], 1);
-    const Run& r = runs_[j];
-    Sum& a = sums[r.id];
-    a.x += r.sum[0];
-    a.y += r.sum[1];
-    a.z += r.sum[2];
-    a.n += r.n;
-  }
   queued_ = 0;
 }
 
 void VoxelGrid::finish(Cloud& out) {
   for (const auto& c : cache_) {
-    if (c.key != kNoKey) queue_run(c);
+    if (c.key == kNoKey) continue;
+    runs_[queued_++] = Run{c.sum, c.key, c.n, 0};
+    if (queued_ == kRunBatch) drain_runs();
   }
   drain_runs();
   out.resize_xyz(voxels_);
@@ -250,12 +263,16 @@ void VoxelGrid::finish(Cloud& out) {
   }
 }
 
-// Points [0, n) of x, y, z (ring: one per point, or null) into their voxels, kBlock keys at a time.
+// Points [0, n) of x, y, z (with a ring each when kRings, else all in ring 0) into their voxels, kBlock keys
+// at a time. A template rather than a test of `ring` per point.
+template <bool kRings>
 void VoxelGrid::add_points(const float* px, const float* py, const float* pz, const std::uint16_t* ring,
                            std::size_t n) {
   std::uint64_t keys[kBlock];
   simd::f32x4 points[kBlock];  // (x, y, z, 0) of each point of the block
   float tx[kBlock] = {}, ty[kBlock] = {}, tz[kBlock] = {};
+  const KeyLanes lanes(inv_[1]);
+  CacheEntry* const cache = cache_.data();
   std::uint32_t queued = queued_;
   for (std::size_t base = 0; base < n; base += kBlock) {
     const std::size_t m = std::min(kBlock, n - base);
@@ -273,7 +290,7 @@ void VoxelGrid::add_points(const float* px, const float* py, const float* pz, co
     if (coarse_) {
       for (std::size_t j = 0; j < m; ++j) keys[j] = coarse_key(bx[j], by[j], bz[j]);
     } else {
-      block_keys(bx, by, bz, inv_[1], keys);
+      block_keys(bx, by, bz, lanes, keys);
     }
     // Four points' coordinates at a time into one vector each, by a transpose rather than point by point.
     for (std::size_t b = 0; b < kBlock; b += 4) {
@@ -284,7 +301,10 @@ void VoxelGrid::add_points(const float* px, const float* py, const float* pz, co
       points[b + 2] = z;
       points[b + 3] = w;
     }
-    for (std::size_t j = 0; j < m; ++j) add(keys[j], ring != nullptr ? ring[base + j] : 0U, points[j], queued);
+    for (std::size_t j = 0; j < m; ++j) {
+      CacheEntry& c = cache[kRings ? ring[base + j] & (kRingCache - 1) : 0U];
+      add(keys[j], c, points[j], queued);
+    }
   }
   queued_ = queued;
 }
@@ -292,7 +312,11 @@ void VoxelGrid::add_points(const float* px, const float* py, const float* pz, co
 void VoxelGrid::filter(const Cloud& in, Cloud& out) {
   const std::size_t n = in.size();
   begin(n);
-  add_points(in.x.data(), in.y.data(), in.z.data(), in.ring.size() == n ? in.ring.data() : nullptr, n);
+  if (in.ring.size() == n) {
+    add_points<true>(in.x.data(), in.y.data(), in.z.data(), in.ring.data(), n);
+  } else {
+    add_points<false>(in.x.data(), in.y.data(), in.z.data(), nullptr, n);
+  }
   finish(out);
 }
 

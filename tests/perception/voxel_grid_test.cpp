@@ -7,7 +7,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <map>
 #include <stdexcept>
+#include <tuple>
 #include <vector>
 
 #include "perception/test_clouds.hpp"
@@ -109,6 +112,80 @@ TEST(VoxelGrid, EmptyInputAndReuseAcrossFrames) {
   ASSERT_EQ(out.size(), 2U);
   EXPECT_FLOAT_EQ(std::min(out.x[0], out.x[1]), 1.0F);
   EXPECT_FLOAT_EQ(std::max(out.x[0], out.x[1]), 3.0F);
+}
+
+// A fresh grid's table grows while the first frame's runs meet it, in the middle of a batch of queued runs:
+// the runs after the growth must look their voxels up in the grown table, or a voxel seen again later is
+// taken for a new one. Every voxel is visited twice, far apart; coordinates exact in float (leaf 0.5).
+TEST(VoxelGrid, TableGrowthInTheMiddleOfABatchKeepsEveryVoxelOnce) {
+  constexpr int kVoxels = 5000;
+  Cloud in;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = 0; i < kVoxels; ++i) {
+      in.push_back(static_cast<float>(i) * 0.5F + (pass == 0 ? 0.125F : 0.375F), 0.125F, 0.25F);
+    }
+  }
+  VoxelGrid grid(VoxelParams{0.5, 0.0, 0.5});
+  Cloud out;
+  for (int frame = 0; frame < 2; ++frame) {  // and again with the grown table
+    grid.filter(in, out);
+    ASSERT_EQ(out.size(), static_cast<std::size_t>(kVoxels));
+    std::vector<float> xs(out.x.begin(), out.x.end());
+    std::sort(xs.begin(), xs.end());
+    for (int i = 0; i < kVoxels; ++i) {
+      ASSERT_EQ(xs[static_cast<std::size_t>(i)], static_cast<float>(i) * 0.5F + 0.25F) << i;
+      ASSERT_EQ(out.y[static_cast<std::size_t>(i)], 0.125F);
+      ASSERT_EQ(out.z[static_cast<std::size_t>(i)], 0.25F);
+    }
+  }
+}
+
+// The same voxels as the stock pcl::VoxelGrid, with the same centroids up to the order of the float sums
+// (PCL adds a voxel's points in index order, ours per ring run): rings cycling as an HDL-32E's firings do,
+// rings beyond the cache, and no rings. Centroids are paired by the voxel they fall in.
+TEST(VoxelGrid, MatchesPclVoxelGrid) {
+  testing::TestRng rng{11};
+  Cloud in;
+  for (int i = 0; i < 30000; ++i) {
+    const float a = rng.uniform(-3.1F, 3.1F), r = rng.uniform(1.F, 40.F);
+    in.push_back(r * std::cos(a), r * std::sin(a), rng.uniform(-1.5F, 3.F), static_cast<std::uint16_t>(i % 32));
+  }
+  for (int variant = 0; variant < 3; ++variant) {
+    Cloud c = in;
+    if (variant == 1) {
+      for (auto& ring : c.ring) ring = static_cast<std::uint16_t>(rng.next() % 300);
+    }
+    if (variant == 2) c.ring.clear();
+    VoxelGrid grid(VoxelParams{0.15, 0.0, 0.45});
+    Cloud out;
+    grid.filter(c, out);
+    pcl::PointCloud<pcl::PointXYZ>::Ptr pin(new pcl::PointCloud<pcl::PointXYZ>);
+    for (std::size_t i = 0; i < c.size(); ++i) pin->push_back(pcl::PointXYZ(c.x[i], c.y[i], c.z[i]));
+    pcl::PointCloud<pcl::PointXYZ> pout;
+    pcl::VoxelGrid<pcl::PointXYZ> pcl_grid;
+    pcl_grid.setInputCloud(pin);
+    pcl_grid.setLeafSize(0.15F, 0.15F, 0.15F);
+    pcl_grid.filter(pout);
+    ASSERT_EQ(out.size(), pout.size()) << variant;
+    const float inv = 1.0F / 0.15F;
+    using Key = std::tuple<int, int, int>;
+    const auto key = [inv](float x, float y, float z) {
+      return Key{static_cast<int>(std::floor(x * inv)), static_cast<int>(std::floor(y * inv)),
+                 static_cast<int>(std::floor(z * inv))};
+    };
+    std::map<Key, P3> ours;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      ours[key(out.x[i], out.y[i], out.z[i])] = {out.x[i], out.y[i], out.z[i]};
+    }
+    ASSERT_EQ(ours.size(), out.size()) << variant;  // one centroid per voxel
+    for (const auto& p : pout) {
+      const auto it = ours.find(key(p.x, p.y, p.z));
+      ASSERT_NE(it, ours.end()) << variant;
+      EXPECT_NEAR(it->second[0], p.x, 1e-4F);
+      EXPECT_NEAR(it->second[1], p.y, 1e-4F);
+      EXPECT_NEAR(it->second[2], p.z, 1e-4F);
+    }
+  }
 }
 
 TEST(VoxelGrid, RefusesAnImpossibleLeaf) {

@@ -4,10 +4,10 @@
 // coarser leaf with range (VoxelParams::coarse_from_m).
 //
 // Fast: voxel keys packed in 64 bits, in a flat open-addressing hash table of 4-byte voxel ids (linear
-// probing; ids offset per frame, so nothing is cleared between frames; small, so that it stays in cache
-// while the rotation streams past); in front of it a per-ring cache of the last
-// voxel with its running sums (a ring's consecutive returns usually share a voxel: 85 % of an HDL-32E
-// rotation's points never reach the table); finished runs meet the table in batches, with the memory they
+// probing, at most a quarter full; ids offset per frame, so nothing is cleared between frames; small, so that
+// it stays in cache while the rotation streams past); in front of it a per-ring cache of the last
+// voxel with its running sums (a ring's consecutive returns usually share a voxel: 72-85 % of an HDL-32E
+// rotation's points, by scene, never reach the table); finished runs meet the table in batches, with the memory they
 // need fetched ahead. Output in the order the voxels' first runs finished, which, as every sum's order,
 // depends only on the input: deterministic.
 // Thread-compatible: one VoxelGrid per thread (it owns its scratch).
@@ -46,15 +46,15 @@ class VoxelGrid {
     Vec4 sum;
     std::uint64_t key;
     std::uint32_t n;
-    std::uint32_t id;
+    std::uint32_t id;  // scratch of drain_runs(): the key's first table slot
   };
   static constexpr std::size_t kRingCache = 128;
   static constexpr std::uint32_t kRunBatch = 64;
 
   void begin(std::size_t max_points);
-  void add(std::uint64_t key, std::uint32_t ring, Vec4 p, std::uint32_t& queued);
+  void add(std::uint64_t key, CacheEntry& c, Vec4 p, std::uint32_t& queued);
+  template <bool kRings>
   void add_points(const float* x, const float* y, const float* z, const std::uint16_t* ring, std::size_t n);
-  void queue_run(const CacheEntry& c);
   void drain_runs();
   void finish(Cloud& out);
   void grow_table();
