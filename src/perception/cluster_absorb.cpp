@@ -1,8 +1,12 @@
 #include "fieldguard/perception/cluster_absorb.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+
+#include "perception/simd.hpp"
 
 namespace fieldguard::perception {
 
@@ -23,23 +27,27 @@ std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
   big_.clear();
   for (std::size_t c = 0; c < nc; ++c) {
     const auto members = clusters[c];
-    for (const std::uint32_t i : members) {
-      if (i >= n) throw std::out_of_range("ClusterAbsorber: a cluster indexes a point past the cloud's end");
-    }
     if (members.empty()) {  // stays out of every test below: an empty box would hold nothing, fit anywhere
       boxes_[c] = Box{{0.F, 0.F, 0.F}, {0.F, 0.F, 0.F}};
       continue;
     }
-    Box b{{cloud.x[members[0]], cloud.y[members[0]], cloud.z[members[0]]},
-          {cloud.x[members[0]], cloud.y[members[0]], cloud.z[members[0]]}};
+    // One pass, each index checked before its point is read; the bounds in six scalars (written as a loop over
+    // three axes, g++ -O2 kept the loop, and it cost most of this stage's instructions).
+    const std::uint32_t first = members[0];
+    if (first >= n) throw std::out_of_range("ClusterAbsorber: a cluster indexes a point past the cloud's end");
+    float lx = cloud.x[first], ly = cloud.y[first], lz = cloud.z[first];
+    float hx = lx, hy = ly, hz = lz;
     for (const std::uint32_t i : members) {
-      const float p[3] = {cloud.x[i], cloud.y[i], cloud.z[i]};
-      for (int k = 0; k < 3; ++k) {
-        b.lo[k] = std::min(b.lo[k], p[k]);
-        b.hi[k] = std::max(b.hi[k], p[k]);
-      }
+      if (i >= n) throw std::out_of_range("ClusterAbsorber: a cluster indexes a point past the cloud's end");
+      const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
+      lx = std::min(lx, x);
+      hx = std::max(hx, x);
+      ly = std::min(ly, y);
+      hy = std::max(hy, y);
+      lz = std::min(lz, z);
+      hz = std::max(hz, z);
     }
-    boxes_[c] = b;
+    boxes_[c] = Box{{lx, ly, lz}, {hx, hy, hz}};
     if (members.size() > max_points_) big_.push_back(static_cast<std::uint32_t>(c));
   }
   if (big_.empty()) return 0;
@@ -49,21 +57,35 @@ std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
     const std::size_t na = clusters[a].size(), nb = clusters[b].size();
     return na != nb ? na > nb : a < b;
   });
+  // The big clusters' boxes grown by the margin, one array per bound in big_'s order, padded to a multiple of
+  // four with boxes that hold nothing (lower bounds +inf, upper -inf): each small cluster is tested against four
+  // at a time, and takes the first that holds it, as one at a time in big_'s order would.
+  const std::size_t nb = big_.size(), padded = (nb + 3) & ~std::size_t{3};
+  for (auto& a : grown_) a.resize(padded);
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (std::size_t j = 0; j < padded; ++j) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      grown_[k][j] = j < nb ? boxes_[big_[j]].lo[k] - margin_ : kInf;
+      grown_[3 + k][j] = j < nb ? boxes_[big_[j]].hi[k] + margin_ : -kInf;
+    }
+  }
   target_.resize(nc);
   std::uint32_t moved = 0;
   for (std::size_t c = 0; c < nc; ++c) {
     target_[c] = static_cast<std::uint32_t>(c);
     if (clusters[c].empty() || clusters[c].size() > max_points_) continue;
     const Box& s = boxes_[c];
-    for (const std::uint32_t b : big_) {
-      const Box& g = boxes_[b];
-      bool inside = true;
-      for (int k = 0; k < 3 && inside; ++k) inside = s.lo[k] >= g.lo[k] - margin_ && s.hi[k] <= g.hi[k] + margin_;
-      if (inside) {
-        target_[c] = b;
-        ++moved;
-        break;
-      }
+    const simd::f32x4 lx = simd::splat(s.lo[0]), ly = simd::splat(s.lo[1]), lz = simd::splat(s.lo[2]);
+    const simd::f32x4 hx = simd::splat(s.hi[0]), hy = simd::splat(s.hi[1]), hz = simd::splat(s.hi[2]);
+    for (std::size_t j = 0; j < padded; j += 4) {
+      const simd::i32x4 inside = (lx >= simd::load(grown_[0].data() + j)) & (ly >= simd::load(grown_[1].data() + j)) &
+                                 (lz >= simd::load(grown_[2].data() + j)) & (hx <= simd::load(grown_[3].data() + j)) &
+                                 (hy <= simd::load(grown_[4].data() + j)) & (hz <= simd::load(grown_[5].data() + j));
+      const unsigned hits = simd::mask_bits(inside);
+      if (hits == 0U) continue;
+      target_[c] = big_[j + static_cast<std::size_t>(std::countr_zero(hits))];
+      ++moved;
+      break;
     }
   }
   if (moved == 0) return 0;

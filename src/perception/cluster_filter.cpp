@@ -73,6 +73,17 @@ std::uint32_t min_points_of(const FilterParams& f, const ClusterSummary& s) {
   return std::min(need, static_cast<std::uint32_t>(std::max(f.float_min_points, 1)));
 }
 
+std::uint32_t least_min_points(const FilterParams& f) {
+  // min_points_at never goes below min_points_floor beyond the full range (nor above min_points anywhere), and
+  // min_points_of lowers that to float_min_points at most.
+  const auto full = static_cast<std::uint32_t>(std::max(f.min_points, 0));
+  std::uint32_t least = full;
+  if (f.min_points_full_range_m > 0.0)
+    least = std::min(least, static_cast<std::uint32_t>(std::max(f.min_points_floor, 0)));
+  if (f.float_min_height_m > 0.0) least = std::min(least, static_cast<std::uint32_t>(std::max(f.float_min_points, 1)));
+  return least;
+}
+
 double min_height_at(const FilterParams& f, float distance_m) {
   const double d = static_cast<double>(distance_m);
   if (!(f.min_height_growth_from_m > 0.0) || !(d > f.min_height_growth_from_m)) return f.min_height_m;

@@ -6,7 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "perception/fast_math.hpp"
+#include "perception/hypot.hpp"
 #include "perception/simd.hpp"
 
 namespace fieldguard::perception {
@@ -28,17 +28,17 @@ constexpr std::uint32_t kInnermostMinPoints = 10;
 
 }  // namespace
 
-// Least squares z = a x + b y + c over the gathered bin points whose residual to `sel` lies in [lo, hi),
+// Least squares z = a x + b y + c over the points pts_ whose residual to `sel` lies in [lo, hi),
 // with the slope pulled towards `prior`'s by prior_per_point for each point used. Four points at a time,
-// branch-free, in float about the bin's first point (a bin spans metres: no cancellation to fear); the
-// gathered arrays are padded to a multiple of four with points that are never selected.
+// branch-free, in float about the first point (a bin spans metres: no cancellation to fear); pts_ is padded to
+// a multiple of four with points that are never selected.
 ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, float hi, const GroundPlane& prior,
                                           double prior_per_point) const {
   using simd::f32x4;
   using simd::i32x4;
   Fit f;
-  if (bin_n_ == 0) return f;
-  const float ox = bx_[0], oy = by_[0], oz = bz_[0];
+  if (pts_.n == 0) return f;
+  const float ox = pts_.x[0], oy = pts_.y[0], oz = pts_.z[0];
   const f32x4 vox = simd::splat(ox), voy = simd::splat(oy), voz = simd::splat(oz);
   const f32x4 sa = simd::splat(sel.a), sb = simd::splat(sel.b), sc = simd::splat(sel.c);
   const f32x4 vlo = simd::splat(lo), vhi = simd::splat(hi);
@@ -46,8 +46,8 @@ ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, floa
   f32x4 n = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, syy = zero, sxz = zero, syz = zero;
   const f32x4 big = simd::splat(std::numeric_limits<float>::max());
   f32x4 x0 = big, x1 = -big, y0 = big, y1 = -big;
-  for (std::size_t i = 0; i < bx_.size(); i += 4) {
-    const f32x4 x = simd::load(bx_.data() + i), y = simd::load(by_.data() + i), z = simd::load(bz_.data() + i);
+  for (std::size_t i = 0; i < pts_.padded; i += 4) {
+    const f32x4 x = simd::load(pts_.x + i), y = simd::load(pts_.y + i), z = simd::load(pts_.z + i);
     const f32x4 r = z - (sa * x + sb * y + sc);
     const i32x4 in = (r >= vlo) & (r < vhi);
     const f32x4 w = __builtin_convertvector(-in, f32x4);  // 1 where selected, 0 elsewhere
@@ -94,35 +94,68 @@ ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, floa
   return f;
 }
 
-// Gathers the points order_[k0, k1) into bx_, by_, bz_, padded to a multiple of four with points that no
-// selection takes (a million metres above the first).
-void ZoneGround::gather(const Cloud& in, std::uint32_t k0, std::uint32_t k1) {
-  const std::size_t m = k1 - k0;
+// The points into sx_ .. sz_ by bin (input order within one, as a stable counting sort leaves them), each bin's
+// run padded to a multiple of four with copies of its first point a million metres up.
+void ZoneGround::sort_into_bins(const Cloud& in) {
+  const std::size_t n = in.size(), nbins = bins_.size();
+  bins_of(in, bin_of_point_);
+  bin_count_.assign(nbins, 0U);
+  for (std::size_t i = 0; i < n; ++i) ++bin_count_[bin_of_point_[i]];
+  bin_start_.resize(nbins + 1);
+  bin_start_[0] = 0;
+  for (std::size_t b = 0; b < nbins; ++b) bin_start_[b + 1] = bin_start_[b] + ((bin_count_[b] + 3U) & ~3U);
+  const std::size_t total = bin_start_[nbins];
+  sx_.resize(total);
+  sy_.resize(total);
+  sz_.resize(total);
+  cursor_.assign(bin_start_.begin(), bin_start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t k = cursor_[bin_of_point_[i]]++;
+    sx_[k] = in.x[i];
+    sy_[k] = in.y[i];
+    sz_[k] = in.z[i];
+  }
+  for (std::size_t b = 0; b < nbins; ++b) {
+    const std::uint32_t first = bin_start_[b];
+    for (std::uint32_t k = first + bin_count_[b]; k < bin_start_[b + 1]; ++k) {
+      sx_[k] = sx_[first];
+      sy_[k] = sy_[first];
+      sz_[k] = sz_[first] + 1e6F;
+    }
+  }
+}
+
+// The points of bins [b0, b1) into bx_ .. bz_, one run padded as a bin's is, for pts_.
+void ZoneGround::gather_innermost(std::uint32_t b0, std::uint32_t b1) {
+  std::size_t m = 0;
+  for (std::uint32_t b = b0; b < b1; ++b) m += bin_count_[b];
   const std::size_t padded = (m + 3) & ~std::size_t{3};
-  bin_n_ = m;
   bx_.resize(padded);
   by_.resize(padded);
   bz_.resize(padded);
-  for (std::size_t j = 0; j < m; ++j) {
-    const std::uint32_t i = order_[k0 + j];
-    bx_[j] = in.x[i];
-    by_[j] = in.y[i];
-    bz_[j] = in.z[i];
+  std::size_t j = 0;
+  for (std::uint32_t b = b0; b < b1; ++b) {
+    for (std::uint32_t k = bin_start_[b]; k < bin_start_[b] + bin_count_[b]; ++k, ++j) {
+      bx_[j] = sx_[k];
+      by_[j] = sy_[k];
+      bz_[j] = sz_[k];
+    }
   }
-  for (std::size_t j = m; j < padded; ++j) {
+  for (; j < padded; ++j) {
     bx_[j] = bx_[0];
     by_[j] = by_[0];
     bz_[j] = bz_[0] + 1e6F;
   }
+  pts_ = Points{bx_.data(), by_.data(), bz_.data(), m, padded};
 }
 
-GroundPlane ZoneGround::fit_innermost(const Cloud& in) {
+GroundPlane ZoneGround::fit_innermost() {
   const GroundPlane level{0.F, 0.F, -sensor_height_m_};
   const Zone& z = zones_[0];
   const std::uint32_t b0 = z.first_bin, b1 = z.first_bin + z.sectors;
   GroundPlane plane = level;
-  if (bin_start_[b1] == bin_start_[b0]) return level;
-  gather(in, bin_start_[b0], bin_start_[b1]);
+  gather_innermost(b0, b1);
+  if (pts_.n == 0) return level;
   for (const float band : kInnermostBands) {
     const Fit f = least_squares(plane, -band, band, level, kInnermostPriorPerPoint);
     if (f.count < kInnermostMinPoints) break;
@@ -141,14 +174,13 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   out.ref_x = prior.ref_x;
   out.ref_y = prior.ref_y;
   out.fitted = false;
-  const std::size_t m = bin_n_;
+  const std::size_t m = pts_.n;
   if (m < static_cast<std::size_t>(std::max(params_.min_bin_points, 3))) return;
 
   // Seeds: the lowest points along the prior's slope.
   const GroundPlane slope{prior.plane.a, prior.plane.b, 0.F};
-  resid_.resize(m);
-  for (std::size_t i = 0; i < m; ++i) resid_[i] = bz_[i] - slope.z_at(bx_[i], by_[i]);
-  tmp_.assign(resid_.begin(), resid_.end());
+  tmp_.resize(m);
+  for (std::size_t i = 0; i < m; ++i) tmp_[i] = pts_.z[i] - slope.z_at(pts_.x[i], pts_.y[i]);
   const std::size_t lowest = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(params_.seed_lowest, 1)), 1, m);
   std::nth_element(tmp_.begin(), tmp_.begin() + static_cast<std::ptrdiff_t>(lowest - 1), tmp_.end());
   float sum = 0.F;
@@ -201,7 +233,7 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   if (params_.max_below_m > 0.0) {
     const float deepest = -static_cast<float>(params_.max_below_m);
     for (std::size_t i = 0; i < m; ++i) {
-      if (bz_[i] - f.plane.z_at(bx_[i], by_[i]) < deepest) return;
+      if (pts_.z[i] - f.plane.z_at(pts_.x[i], pts_.y[i]) < deepest) return;
     }
   }
   out.plane = f.plane;
@@ -266,60 +298,54 @@ void ZoneGround::interpolate_gaps() {
   for (std::size_t b = 0; b < bins_.size(); ++b) bins_[b].plane = filled_[b];
 }
 
-// The ground under (x, y) in `bin`: between where its plane was fitted and where the plane of the bin beyond
-// it on the point's side (outside it when the point lies farther out than that, else inside) was fitted, the
-// two planes interpolated by distance, as a ring's measured ground gives way to the next ring's. A neighbour
-// without a plane of its own does not count (its plane is a blend already).
-float ZoneGround::blended_z(std::uint32_t bin, float x, float y) const {
-  const Bin& own = bins_[bin];
-  const float z_own = own.plane.z_at(x, y);
-  const float r2 = x * x + y * y, ref_r2 = own.ref_x * own.ref_x + own.ref_y * own.ref_y;
-  const std::uint32_t nb = r2 >= ref_r2 ? outer_[bin] : inner_[bin];
-  if (nb == kNoBin || !bins_[nb].fitted) return z_own;
-  const Bin& other = bins_[nb];
-  const float d_own = std::hypot(x - own.ref_x, y - own.ref_y);
-  const float d_other = std::hypot(x - other.ref_x, y - other.ref_y);
-  const float sum = d_own + d_other;
-  if (!(sum > 0.F)) return z_own;
-  return (d_other * z_own + d_own * other.plane.z_at(x, y)) / sum;
+// Heights and labels. A point's ground, with blend_radial: between where its bin's plane was fitted and where the
+// plane of the bin beyond it on the point's side (outside it when the point lies farther out than that, else inside)
+// was fitted, the two planes interpolated by distance, as a ring's measured ground gives way to the next ring's. A
+// neighbour without a plane of its own does not count (its plane is a blend already).
+void ZoneGround::label(const Cloud& in, GroundLabels& out) {
+  const auto guess = static_cast<float>(params_.max_extrapolation_m);
+  label_.resize(bins_.size());
+  const auto fitted_or_none = [this](std::uint32_t b) { return b != kNoBin && bins_[b].fitted ? b : kNoBin; };
+  for (std::uint32_t b = 0; b < bins_.size(); ++b) {
+    const Bin& bin = bins_[b];
+    label_[b] = Label{bin.plane,
+                      bin.ref_x,
+                      bin.ref_y,
+                      bin.ref_x * bin.ref_x + bin.ref_y * bin.ref_y,
+                      fitted_or_none(outer_[b]),
+                      fitted_or_none(inner_[b]),
+                      bin.support_m > guess ? std::uint8_t{1} : std::uint8_t{0}};
+  }
+  const auto threshold = static_cast<float>(params_.ground_threshold_m);
+  const bool blend = params_.blend_radial;
+  const std::size_t n = in.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Label& own = label_[bin_of_point_[i]];
+    const float x = in.x[i], y = in.y[i];
+    float g = own.plane.z_at(x, y);
+    if (blend) {
+      const std::uint32_t nb = x * x + y * y >= own.ref_r2 ? own.outer : own.inner;
+      if (nb != kNoBin) {
+        const Label& other = label_[nb];
+        const float d_own = hypot_f(x - own.ref_x, y - own.ref_y);
+        const float d_other = hypot_f(x - other.ref_x, y - other.ref_y);
+        const float sum = d_own + d_other;
+        if (sum > 0.F) g = (d_other * g + d_own * other.plane.z_at(x, y)) / sum;
+      }
+    }
+    const float h = in.z[i] - g;
+    out.height_m[i] = h;
+    out.ground[i] = h < threshold ? 1U : 0U;
+    out.guessed[i] = own.guessed;
+  }
 }
 
 void ZoneGround::segment(const Cloud& in, GroundLabels& out) {
-  const std::size_t n = in.size();
-  const std::size_t nbins = bins_.size();
-  out.resize(n);
-  bin_of_point_.resize(n);
-  bin_start_.assign(nbins + 1, 0U);
-  // Range and angle four points at a time (the same arithmetic as bin_of, lane by lane).
-  std::size_t p = 0;
-  for (; p + 4 <= n; p += 4) {
-    const simd::f32x4 x = simd::load(in.x.data() + p), y = simd::load(in.y.data() + p);
-    const simd::f32x4 r2 = x * x + y * y;
-    const simd::f32x4 r = {std::sqrt(r2[0]), std::sqrt(r2[1]), std::sqrt(r2[2]), std::sqrt(r2[3])};
-    const simd::f32x4 theta = fast_atan2(y, x);
-    for (int k = 0; k < 4; ++k) {
-      const std::uint32_t b = bin_of_polar(r[k], theta[k]);
-      bin_of_point_[p + static_cast<std::size_t>(k)] = b;
-      ++bin_start_[b + 1];
-    }
-  }
-  for (; p < n; ++p) {
-    const std::uint32_t b = bin_of(in.x[p], in.y[p]);
-    bin_of_point_[p] = b;
-    ++bin_start_[b + 1];
-  }
-  for (std::size_t b = 0; b < nbins; ++b) bin_start_[b + 1] += bin_start_[b];
-  order_.resize(n);
-  tmp_.clear();
-  {
-    // Counting sort of the point indices by bin (stable: input order within a bin).
-    Buffer<std::uint32_t>& cursor = cursor_;
-    cursor.assign(bin_start_.begin(), bin_start_.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) order_[cursor[bin_of_point_[i]]++] = static_cast<std::uint32_t>(i);
-  }
+  out.resize(in.size());
+  sort_into_bins(in);
 
   Bin innermost;
-  innermost.plane = fit_innermost(in);
+  innermost.plane = fit_innermost();
   innermost.fitted = true;
 
   for (std::uint32_t zi = 0; zi < zones_.size(); ++zi) {
@@ -327,7 +353,9 @@ void ZoneGround::segment(const Cloud& in, GroundLabels& out) {
     for (std::uint32_t ring = 0; ring < z.rings; ++ring) {
       for (std::uint32_t s = 0; s < z.sectors; ++s) {
         const std::uint32_t b = z.first_bin + ring * z.sectors + s;
-        gather(in, bin_start_[b], bin_start_[b + 1]);
+        const std::uint32_t first = bin_start_[b];
+        pts_ = Points{sx_.data() + first, sy_.data() + first, sz_.data() + first, bin_count_[b],
+                      bin_start_[b + 1] - first};
         const Bin prior = (zi == 0 && ring == 0) ? innermost : bins_[inner_[b]];
         fit_bin(b, prior);
       }
@@ -336,17 +364,7 @@ void ZoneGround::segment(const Cloud& in, GroundLabels& out) {
 
   interpolate_gaps();
 
-  const auto threshold = static_cast<float>(params_.ground_threshold_m);
-  const auto guess = static_cast<float>(params_.max_extrapolation_m);
-  const bool blend = params_.blend_radial;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Bin& bin = bins_[bin_of_point_[i]];
-    const float g = blend ? blended_z(bin_of_point_[i], in.x[i], in.y[i]) : bin.plane.z_at(in.x[i], in.y[i]);
-    const float h = in.z[i] - g;
-    out.height_m[i] = h;
-    out.ground[i] = h < threshold ? 1U : 0U;
-    out.guessed[i] = bin.support_m > guess ? 1U : 0U;
-  }
+  label(in, out);
 }
 
 }  // namespace fieldguard::perception

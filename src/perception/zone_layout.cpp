@@ -3,12 +3,18 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
 
 #include "fieldguard/perception/zone_ground.hpp"
 #include "perception/fast_math.hpp"
+#include "perception/simd.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace fieldguard::perception {
 namespace {
@@ -114,6 +120,67 @@ std::uint32_t ZoneGround::bin_of_polar(float r, float theta) const {
   sf = sf > 0.F ? sf : 0.F;
   sf = sf < z.max_sector ? sf : z.max_sector;
   return z.first_bin + static_cast<std::uint32_t>(rf) * z.sectors + static_cast<std::uint32_t>(sf);
+}
+
+void ZoneGround::bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const {
+  using simd::f32x4;
+  using simd::i32x4;
+  const std::size_t n = in.size();
+  out.resize(n);
+  // Each zone's constants, one lane each, chosen per lane by how many zone ends the range has passed (the ends
+  // increase, so passing one passes all before it: bin_of_polar's count). NaN passes none: the first zone, as there.
+  struct Lanes {
+    f32x4 r0, inv_ring_width, max_ring, sector_scale, max_sector;
+    i32x4 first_bin, sectors;
+  };
+  const auto lanes_of = [](const Zone& z) {
+    return Lanes{simd::splat(z.r0),
+                 simd::splat(z.inv_ring_width),
+                 simd::splat(z.max_ring),
+                 simd::splat(z.sector_scale),
+                 simd::splat(z.max_sector),
+                 simd::splat(static_cast<std::int32_t>(z.first_bin)),
+                 simd::splat(static_cast<std::int32_t>(z.sectors))};
+  };
+  // Splatted once per call, not per step: the selects below read them from memory (they are more than the vector
+  // registers). ends[k]: where zone k + 1 begins.
+  std::vector<Lanes> lanes;
+  std::vector<f32x4> ends;
+  for (const Zone& z : zones_) lanes.push_back(lanes_of(z));
+  for (std::size_t k = 1; k < zones_.size(); ++k) ends.push_back(simd::splat(zones_[k - 1].r1));
+  const f32x4 zero = simd::splat(0.F), pi = simd::splat(std::numbers::pi_v<float>);
+  std::size_t p = 0;
+  for (; p + 4 <= n; p += 4) {
+    const f32x4 x = simd::load(in.x.data() + p), y = simd::load(in.y.data() + p);
+    const f32x4 r2 = x * x + y * y;
+#if defined(__SSE2__)
+    const f32x4 r = _mm_sqrt_ps(r2);  // correctly rounded, as std::sqrt
+#else
+    const f32x4 r = {std::sqrt(r2[0]), std::sqrt(r2[1]), std::sqrt(r2[2]), std::sqrt(r2[3])};
+#endif
+    const f32x4 theta = fast_atan2(y, x);
+    Lanes z = lanes[0];
+    for (std::size_t k = 1; k < lanes.size(); ++k) {
+      const i32x4 past = r >= ends[k - 1];
+      const Lanes& o = lanes[k];
+      z.r0 = past ? o.r0 : z.r0;
+      z.inv_ring_width = past ? o.inv_ring_width : z.inv_ring_width;
+      z.max_ring = past ? o.max_ring : z.max_ring;
+      z.sector_scale = past ? o.sector_scale : z.sector_scale;
+      z.max_sector = past ? o.max_sector : z.max_sector;
+      z.first_bin = past ? o.first_bin : z.first_bin;
+      z.sectors = past ? o.sectors : z.sectors;
+    }
+    f32x4 rf = (r - z.r0) * z.inv_ring_width;
+    rf = rf > zero ? rf : zero;
+    rf = rf < z.max_ring ? rf : z.max_ring;
+    f32x4 sf = (theta + pi) * z.sector_scale;
+    sf = sf > zero ? sf : zero;
+    sf = sf < z.max_sector ? sf : z.max_sector;
+    const i32x4 b = z.first_bin + __builtin_convertvector(rf, i32x4) * z.sectors + __builtin_convertvector(sf, i32x4);
+    std::memcpy(out.data() + p, &b, sizeof b);
+  }
+  for (; p < n; ++p) out[p] = bin_of(in.x[p], in.y[p]);
 }
 
 GroundPlane ZoneGround::plane_at(float x, float y) const { return bins_[bin_of(x, y)].plane; }

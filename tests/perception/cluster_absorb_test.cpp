@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -104,6 +107,86 @@ TEST(ClusterAbsorber, PartialClusteringAndBadInput) {
   EXPECT_THROW(ClusterAbsorber(-1, 0.3), std::invalid_argument);
   EXPECT_THROW(ClusterAbsorber(10, -0.1), std::invalid_argument);
   EXPECT_THROW(ClusterAbsorber(10, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+}
+
+// The rule written plainly: each small cluster to the first big one (most points, then lowest index) whose box,
+// grown by the margin, holds its box. The absorber tests four big boxes at a time; its choice must be this one,
+// with more big clusters than one group of four, boxes inside boxes and boxes sharing an edge.
+TEST(ClusterAbsorber, TakesTheFirstHoldingBoxAsOneAtATime) {
+  std::uint64_t seed = 3;
+  const auto next = [&seed] {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
+  };
+  for (int trial = 0; trial < 40; ++trial) {
+    Cloud c;
+    Sets sets;
+    const auto add_cluster = [&](std::size_t points, float x, float y, float size) {
+      std::vector<std::uint32_t> members;
+      for (std::size_t k = 0; k < points; ++k) {
+        members.push_back(static_cast<std::uint32_t>(c.size()));
+        // On a 0.1 m lattice: boxes often share an edge exactly.
+        c.push_back(x + std::round(size * next() * 10.F) / 10.F, y + std::round(size * next() * 10.F) / 10.F,
+                    std::round(2.F * next() * 10.F) / 10.F);
+      }
+      sets.push_back(members);
+    };
+    const int big = 1 + trial % 11;
+    for (int b = 0; b < big; ++b)
+      add_cluster(11 + static_cast<std::size_t>(next() * 5.F), 4.F * next(), 4.F * next(), 3.F);
+    for (int f = 0; f < 60; ++f)
+      add_cluster(1 + static_cast<std::size_t>(next() * 10.F), 6.F * next(), 6.F * next(), 0.5F);
+    const float margin = 0.1F * static_cast<float>(trial % 4);
+    // The expected result, one big box at a time.
+    struct Box {
+      float lo[3], hi[3];
+    };
+    std::vector<Box> boxes;
+    for (const auto& m : sets) {
+      Box b{{c.x[m[0]], c.y[m[0]], c.z[m[0]]}, {c.x[m[0]], c.y[m[0]], c.z[m[0]]}};
+      for (const std::uint32_t i : m) {
+        const float p[3] = {c.x[i], c.y[i], c.z[i]};
+        for (int k = 0; k < 3; ++k) {
+          b.lo[k] = std::min(b.lo[k], p[k]);
+          b.hi[k] = std::max(b.hi[k], p[k]);
+        }
+      }
+      boxes.push_back(b);
+    }
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < sets.size(); ++k) {
+      if (sets[k].size() > 10) order.push_back(k);
+    }
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return sets[a].size() > sets[b].size(); });
+    Sets expected = sets;
+    std::uint32_t moved = 0;
+    for (std::size_t k = 0; k < sets.size(); ++k) {
+      if (sets[k].size() > 10) continue;
+      for (const std::size_t b : order) {
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) {
+          inside = inside && boxes[k].lo[a] >= boxes[b].lo[a] - margin && boxes[k].hi[a] <= boxes[b].hi[a] + margin;
+        }
+        if (inside) {
+          expected[b].insert(expected[b].end(), sets[k].begin(), sets[k].end());
+          expected[k].clear();
+          ++moved;
+          break;
+        }
+      }
+    }
+    expected.erase(std::remove_if(expected.begin(), expected.end(), [](const auto& m) { return m.empty(); }),
+                   expected.end());
+    Clusters k = clusters_of(sets);
+    ClusterAbsorber absorber(10, static_cast<double>(margin));
+    ASSERT_EQ(absorber.absorb(c, k), moved) << "trial " << trial;
+    ASSERT_GT(moved, 0U);
+    // As the absorber gives them: members ascending, clusters by their lowest point.
+    for (auto& m : expected) std::sort(m.begin(), m.end());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(sets_of(k), expected) << "trial " << trial;
+  }
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "perception/test_clouds.hpp"
@@ -98,7 +100,7 @@ TEST(ClusterFilter, AFloatingClusterNeedsFewerPoints) {
 
 // Far out a ring's slice of a clod stands 0.5-0.65 m above ground measured by one or two rings; a person 1.4 m.
 TEST(ClusterFilter, LeastHeightGrowsWithDistance) {
-  FilterParams f;  // min_height_m 0.5
+  FilterParams f;                    // min_height_m 0.5
   f.min_height_growth_from_m = 0.0;  // growth off
   const ClusterSummary clod = summary(4, 40.F, {0.3F, 0.4F, 0.1F}, 0.6F);
   const ClusterSummary person = summary(4, 40.F, {0.2F, 0.5F, 1.4F}, 1.4F);
@@ -167,6 +169,39 @@ TEST(ClusterFilter, GuessedGroundLimitsTheHeightToTheClustersOwnExtent) {
   s = summarize(c, heights, guessed, members);
   limit_height_to_extent(s, -1.86F);
   EXPECT_NEAR(s.height_above_ground_m, 0.71F, 1e-5F);
+}
+
+// The pipeline rejects a cluster with fewer than least_min_points points without summarizing it: no summary may
+// let such a cluster through, under any of the rules that lower the count (distance, floating), on or off.
+TEST(ClusterFilter, NoClusterBelowTheLeastMinimumPasses) {
+  std::uint64_t seed = 5;
+  const auto next = [&seed] {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
+  };
+  for (int variant = 0; variant < 16; ++variant) {
+    FilterParams f;
+    f.min_points = 6 + variant % 3;
+    f.min_points_floor = variant % 4 == 3 ? -1 : 2 + variant % 2;
+    f.min_points_full_range_m = (variant & 4) != 0 ? 0.0 : 12.0;
+    f.float_min_height_m = (variant & 8) != 0 ? 0.0 : 1.0;
+    f.float_min_points = variant % 5 == 4 ? 0 : 3;
+    const std::uint32_t least = least_min_points(f);
+    bool reached = false;  // some summary needs no more than `least`: it is the least, not merely a bound
+    for (int i = 0; i < 20000; ++i) {
+      ClusterSummary s;
+      s.points = static_cast<std::uint32_t>(next() * 10.F);
+      s.distance_m = i % 97 == 0 ? std::numeric_limits<float>::quiet_NaN() : 1e7F * next() * next() * next();
+      s.lowest_above_ground_m = 3.F * next() - 1.F;
+      s.height_above_ground_m = s.lowest_above_ground_m + 2.F;
+      s.max = {1.F, 1.F, 1.F};
+      if (s.points < least) {
+        ASSERT_EQ(check_cluster(f, s), Rejection::TooFewPoints) << variant << " " << s.points;
+      }
+      reached = reached || min_points_of(f, s) == least;
+    }
+    EXPECT_TRUE(reached) << variant;
+  }
 }
 
 }  // namespace

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
@@ -11,6 +14,7 @@
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
+#include "perception/hypot.hpp"
 #include "perception/test_clouds.hpp"
 
 namespace fieldguard::perception {
@@ -45,7 +49,8 @@ TEST(ZoneGround, FindsATiltedPlaneWithinOneDegree) {
   for (float x = 3.F; x < 30.F; x += 1.5F) {
     for (float y = -9.F; y <= 9.F; y += 1.5F) {
       // The ground under (x, y) in the sensor frame (sensor 0.95 m above the ground at the origin).
-      const auto truth = static_cast<float>(scene.terrain.z(static_cast<double>(x), static_cast<double>(y)) - scene.sensor_height_m);
+      const auto truth =
+          static_cast<float>(scene.terrain.z(static_cast<double>(x), static_cast<double>(y)) - scene.sensor_height_m);
       EXPECT_NEAR(zones.ground_z(x, y), truth, 0.06F) << x << ", " << y;
       if (!zones.fitted_at(x, y)) continue;
       ++fitted;
@@ -127,7 +132,8 @@ TEST(ZoneGround, RidgeOnASlopeIsNotGroundAndNotAnObstacle) {
   EXPECT_NEAR(with_people.obstacles[0].height_above_ground_m, 1.47F, 0.2F);
   EXPECT_NEAR(with_people.obstacles[1].height_above_ground_m, 1.3F, 0.2F);
   for (const float x : {15.F, 30.F}) {
-    EXPECT_NEAR(pipe.ground_z(x, 0.F), static_cast<float>(scene.terrain.z(static_cast<double>(x), 0.0) - scene.sensor_height_m), 0.15F);
+    EXPECT_NEAR(pipe.ground_z(x, 0.F),
+                static_cast<float>(scene.terrain.z(static_cast<double>(x), 0.0) - scene.sensor_height_m), 0.15F);
   }
 }
 
@@ -303,6 +309,80 @@ TEST(ZoneGround, RefusesALayoutThatIsNone) {
   p.rings = {1, 0};
   p.sectors = {8, 8};
   EXPECT_THROW(ZoneGround{p}, std::invalid_argument);
+}
+
+// segment() bins four points at a time; the surface it leaves is looked up one point at a time (bin_of). The two
+// must agree to the bin everywhere: in each zone, on its edges, beyond the last, at the sensor, and for NaN.
+TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
+  ZoneParams p;
+  p.edges_m = {2.0, 6.0, 14.0, 26.0, 50.0};
+  p.rings = {2, 4, 4, 4};
+  p.sectors = {16, 32, 48, 64};
+  const ZoneGround zones(p);
+  Cloud c;
+  std::uint64_t seed = 7;
+  const auto next = [&seed] {  // a small LCG: the same points on every machine
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
+  };
+  for (int i = 0; i < 20000; ++i) {
+    const float r = 60.F * next() * next(), a = static_cast<float>(2.0 * kPi) * next();
+    c.push_back(r * std::cos(a), r * std::sin(a), 0.F);
+  }
+  for (const double e : p.edges_m) {  // exactly on each zone edge, all round
+    for (int k = 0; k < 64; ++k) {
+      const double a = 2.0 * kPi * k / 64.0;
+      c.push_back(static_cast<float>(e * std::cos(a)), static_cast<float>(e * std::sin(a)), 0.F);
+    }
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  c.push_back(0.F, 0.F, 0.F);
+  c.push_back(-0.F, -0.F, 0.F);
+  c.push_back(-3.F, 0.F, 0.F);  // bearing pi: the seam
+  c.push_back(-3.F, -0.F, 0.F);
+  c.push_back(nan, 1.F, 0.F);
+  c.push_back(1.F, nan, 0.F);
+  c.push_back(1e30F, -1e30F, 0.F);
+  c.push_back(5.F, 5.F, 0.F);  // and a tail of fewer than four
+  c.push_back(-20.F, 7.F, 0.F);
+  Buffer<std::uint32_t> bins;
+  zones.bins_of(c, bins);
+  ASSERT_EQ(bins.size(), c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    ASSERT_EQ(bins[i], zones.bin_of(c.x[i], c.y[i])) << "point " << i << " at " << c.x[i] << ", " << c.y[i];
+    ASSERT_LT(bins[i], zones.bin_count());
+  }
+}
+
+// The ground's distances go through hypot_f: it must give std::hypot's bits, or heights (and obstacles) change.
+TEST(ZoneGround, HypotGivesTheLibrarysBits) {
+  std::uint64_t seed = 11;
+  const auto bits = [&seed] {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<std::uint32_t>(seed >> 32);
+  };
+  const auto from_bits = [](std::uint32_t u) {
+    float f = 0.F;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+  };
+  const auto same = [](float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b));
+  };
+  for (int i = 0; i < 2000000; ++i) {
+    const float x = from_bits(bits()), y = from_bits(bits());  // every exponent, NaN and infinity among them
+    ASSERT_TRUE(same(hypot_f(x, y), std::hypot(x, y))) << x << ", " << y;
+  }
+  for (int i = 0; i < 2000000; ++i) {  // and the ground's own scale: metres, near one another
+    const float x = from_bits(0x3C000000U + bits() % 0x05000000U), y = from_bits(0x3C000000U + bits() % 0x05000000U);
+    ASSERT_TRUE(same(hypot_f(x, -y), std::hypot(x, -y))) << x << ", " << y;
+  }
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(hypot_f(inf, nan), inf);
+  EXPECT_EQ(hypot_f(nan, -inf), inf);
+  EXPECT_TRUE(std::isnan(hypot_f(nan, 1.F)));
+  EXPECT_EQ(hypot_f(3e38F, 3e38F), inf);
+  EXPECT_EQ(hypot_f(0.F, -0.F), 0.F);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 // Output as EuclideanClusterer's: clusters in the order of their lowest point index, indices ascending within a
 // cluster. Thread-compatible.
 
+#include <array>
 #include <cstdint>
 
 #include "fieldguard/perception/cloud.hpp"
@@ -39,8 +40,9 @@ class ClusterAbsorber {
   float margin_;
   // Scratch, reused across frames.
   Buffer<Box> boxes_;
-  Buffer<std::uint32_t> big_;     // clusters with more than max_points_ points, most points first
-  Buffer<std::uint32_t> target_;  // per cluster: the cluster it ends in
+  Buffer<std::uint32_t> big_;           // clusters with more than max_points_ points, most points first
+  std::array<Buffer<float>, 6> grown_;  // the big clusters' boxes grown by margin_: lo x, y, z, hi x, y, z
+  Buffer<std::uint32_t> target_;        // per cluster: the cluster it ends in
   Buffer<std::uint32_t> of_point_;
   Buffer<std::uint32_t> id_;
   Buffer<std::uint32_t> count_;

@@ -46,6 +46,10 @@ void limit_height_to_extent(ClusterSummary& s, float floor_z);
 // (its lowest point at least float_min_height_m above its ground).
 [[nodiscard]] std::uint32_t min_points_of(const FilterParams& f, const ClusterSummary& s);
 
+// The least point count min_points_of can ask of any cluster, wherever it stands: a cluster with fewer points is
+// TooFewPoints whatever its summary says, so the pipeline rejects it without summarizing it.
+[[nodiscard]] std::uint32_t least_min_points(const FilterParams& f);
+
 // The least height above ground of a cluster at `distance_m`: min_height_m, or beyond min_height_growth_from_m
 // min_height_m + min_height_growth_per_m * (d - from), never above min_height_growth_max_m when that is set.
 [[nodiscard]] double min_height_at(const FilterParams& f, float distance_m);

@@ -52,6 +52,9 @@ class ZoneGround {
   [[nodiscard]] std::size_t bin_count() const { return bins_.size(); }
   [[nodiscard]] std::uint32_t bin_of(float x, float y) const;
   [[nodiscard]] std::uint32_t bin_of_polar(float r, float theta) const;
+  // bin_of for every point of `in` into `out` (resized): four at a time, the same arithmetic lane by lane, so the
+  // same bins.
+  void bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const;
 
  private:
   struct Zone {
@@ -75,13 +78,14 @@ class ZoneGround {
     float spread = 0.F;
   };
 
-  GroundPlane fit_innermost(const Cloud& in);
+  GroundPlane fit_innermost();
   void fit_bin(std::uint32_t bin, const Bin& prior);
   [[nodiscard]] Fit least_squares(const GroundPlane& sel, float lo, float hi, const GroundPlane& prior,
                                   double prior_per_point) const;
-  void gather(const Cloud& in, std::uint32_t k0, std::uint32_t k1);
+  void sort_into_bins(const Cloud& in);
+  void gather_innermost(std::uint32_t b0, std::uint32_t b1);
   void interpolate_gaps();
-  [[nodiscard]] float blended_z(std::uint32_t bin, float x, float y) const;
+  void label(const Cloud& in, GroundLabels& out);
 
   ZoneParams params_;
   std::vector<Zone> zones_;
@@ -89,15 +93,36 @@ class ZoneGround {
   std::vector<Bin> bins_;
   std::vector<std::uint32_t> inner_, outer_;  // per bin: the bin just inside / outside it, or kNoBin
   std::vector<GroundPlane> filled_;
+  // Per bin, once its plane is final: what labelling a point in it needs, in one place (the per-point work was the
+  // bin's plane, its neighbours' and their `fitted` flags, looked up point by point).
+  struct Label {
+    GroundPlane plane;
+    float ref_x, ref_y, ref_r2;  // where its plane was fitted, and that place's squared range
+    std::uint32_t outer, inner;  // the bin outside / inside it when that one has its own plane, else kNoBin
+    std::uint8_t guessed;        // GroundLabels::guessed for its points
+  };
+  std::vector<Label> label_;
   float sensor_height_m_;
   float tan_max_slope_ = 0.F, tan_max_tilt_ = 0.F, tan_max_change_ = 0.F;
   // Scratch, reused across frames.
   Buffer<std::uint32_t> bin_of_point_;
-  Buffer<std::uint32_t> bin_start_;
-  Buffer<std::uint32_t> order_;
+  // The points sorted by bin (input order within one), each bin's run padded to a multiple of four with points
+  // no selection takes (a million metres above its first): least_squares reads a bin four points at a time
+  // where it lies, without copying it out first.
+  Buffer<std::uint32_t> bin_count_;
+  Buffer<std::uint32_t> bin_start_;  // per bin (and one past the last): where its run starts in sx_ .. sz_
   Buffer<std::uint32_t> cursor_;
-  Buffer<float> bx_, by_, bz_, resid_, tmp_;  // the bin's points (padded), and scratch
-  std::size_t bin_n_ = 0;                     // points in bx_ .. bz_ before the padding
+  Buffer<float> sx_, sy_, sz_;
+  Buffer<float> bx_, by_, bz_, tmp_;  // the innermost ring's points (padded), and scratch
+  // The points least_squares and fit_bin look at: one bin's run, or the innermost ring's.
+  struct Points {
+    const float* x = nullptr;
+    const float* y = nullptr;
+    const float* z = nullptr;
+    std::size_t n = 0;       // points
+    std::size_t padded = 0;  // n rounded up to a multiple of four: readable, the rest never selected
+  };
+  Points pts_;
 };
 
 }  // namespace fieldguard::perception
