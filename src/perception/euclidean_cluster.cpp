@@ -19,6 +19,11 @@ constexpr std::size_t kMinColumns = std::size_t{1} << 20;
 // and that rounding must not make a cell pair look farther apart than two of its points are.
 constexpr float kSlack = 1e-3F;
 
+// A radius that grows with range: `t` up close, `growth` per metre of range farther out, at most `cap`.
+inline float grow(float t, float growth, float cap, float range_m) {
+  return std::min(cap, std::max(t, growth * range_m));
+}
+
 // Union-find over cells: the root of `c`, halving the path on the way.
 inline std::uint32_t find_root(std::uint32_t* parent, std::uint32_t c) {
   while (parent[c] != c) {
@@ -62,6 +67,19 @@ bool cells_join(std::uint32_t a0, std::uint32_t a1, std::uint32_t b0, std::uint3
 
 }  // namespace
 
+// The adaptive and anisotropic radii at a 3D range, as every pair test takes them. A local copy of the
+// clusterer's parameters because the hot loops need these inlined, which a member function is not in a
+// position-independent build (it could be interposed).
+struct EuclideanClusterer::RadiusModel {
+  float t;        // the smallest radius
+  float base_r2;  // its square as PCL rounds it
+  float gv, cap_v, gh, cap_h;
+  bool aniso;
+  [[nodiscard]] float v(float range_m) const { return grow(t, gv, cap_v, range_m); }
+  [[nodiscard]] float h(float range_m) const { return aniso ? grow(t, gh, cap_h, range_m) : v(range_m); }
+  [[nodiscard]] float squared(float radius) const { return radius == t ? base_r2 : radius * radius; }
+};
+
 EuclideanClusterer::EuclideanClusterer(const ClusterParams& params) : params_(params) {
   if (!(params_.tolerance_m > 0.0) || !std::isfinite(params_.tolerance_m)) {
     throw std::invalid_argument("EuclideanClusterer: tolerance_m must be positive");
@@ -97,7 +115,11 @@ EuclideanClusterer::EuclideanClusterer(const ClusterParams& params) : params_(pa
 
 // A radius that grows with range: tolerance_m up close, `growth` per metre of range farther out, at most `cap`.
 float EuclideanClusterer::grown(float growth, float cap, float range_m) const {
-  return std::min(cap, std::max(static_cast<float>(params_.tolerance_m), growth * range_m));
+  return grow(static_cast<float>(params_.tolerance_m), growth, cap, range_m);
+}
+
+EuclideanClusterer::RadiusModel EuclideanClusterer::radius_model() const {
+  return {static_cast<float>(params_.tolerance_m), base_r2_, growth_, cap_, growth_h_, cap_h_, anisotropic_};
 }
 
 float EuclideanClusterer::horizontal_radius_at(float range_m) const {
@@ -113,11 +135,11 @@ void EuclideanClusterer::extract(const Cloud& in, Clusters& out) {
   out.offsets.clear();
   out.offsets.push_back(0);
   if (in.empty()) return;
-  prepare(in);
   if (params_.structure == ClusterStructure::KdTree) {
+    prepare(in);
     extract_kdtree(in, out);
   } else {
-    extract_grid(in, out);
+    extract_grid(in, out);  // its own radii, in its own order (prepare only if it falls back to the k-d tree)
   }
 }
 
@@ -132,23 +154,18 @@ void EuclideanClusterer::prepare(const Cloud& in) {
   r2_.resize(n);
   query_.resize(n);
   if (anisotropic_) h2_.resize(n);
-  const auto t = static_cast<float>(params_.tolerance_m);
   // Anisotropic: each radius is at most max(t, g * range) capped, with g the larger growth and the larger cap,
   // so the same bound holds with those.
   const float g = anisotropic_ ? std::max(growth_, growth_h_) : growth_;
   const float cap = anisotropic_ ? std::max(cap_, cap_h_) : cap_;
   const float reach = g / (1.F - g);
+  const RadiusModel rm = radius_model();
   for (std::size_t i = 0; i < n; ++i) {
     const float range = std::sqrt(in.x[i] * in.x[i] + in.y[i] * in.y[i] + in.z[i] * in.z[i]);
-    const float v = grown(growth_, cap_, range);
-    r2_[i] = v == t ? base_r2_ : v * v;
-    float farthest = v;
-    if (anisotropic_) {
-      const float h = grown(growth_h_, cap_h_, range);
-      h2_[i] = h == t ? base_r2_ : h * h;
-      farthest = std::max(v, h);
-    }
-    query_[i] = std::max(farthest, std::min(cap, reach * range));
+    const float v = rm.v(range), h = rm.h(range);
+    r2_[i] = rm.squared(v);
+    if (anisotropic_) h2_[i] = rm.squared(h);
+    query_[i] = std::max(std::max(v, h), std::min(cap, reach * range));
   }
 }
 
@@ -236,18 +253,36 @@ void EuclideanClusterer::extract_kdtree(const Cloud& in, Clusters& out) {
 // k-d tree's.
 void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   const std::size_t n = in.size();
+  // Bounds, four points at a time. x - x is 0 for a finite x and NaN for anything else, so one running sum
+  // per axis tells whether every coordinate is finite (the min and max pass over a NaN; the sum does not).
   float lo[3] = {in.x[0], in.y[0], in.z[0]};
   float hi[3] = {lo[0], lo[1], lo[2]};
   bool finite = true;
-  for (std::size_t i = 0; i < n; ++i) {
-    const float x = in.x[i], y = in.y[i], z = in.z[i];
-    finite = finite && std::isfinite(x) && std::isfinite(y) && std::isfinite(z);
-    lo[0] = std::min(lo[0], x);
-    hi[0] = std::max(hi[0], x);
-    lo[1] = std::min(lo[1], y);
-    hi[1] = std::max(hi[1], y);
-    lo[2] = std::min(lo[2], z);
-    hi[2] = std::max(hi[2], z);
+  {
+    const float* axis[3] = {in.x.data(), in.y.data(), in.z.data()};
+    const std::size_t n4 = n & ~std::size_t{3};
+    for (int k = 0; k < 3; ++k) {
+      const float* v = axis[k];
+      simd::f32x4 mn = simd::splat(lo[k]), mx = mn, bad = simd::splat(0.F);
+      for (std::size_t i = 0; i < n4; i += 4) {
+        const simd::f32x4 q = simd::load(v + i);
+        mn = q < mn ? q : mn;
+        mx = q > mx ? q : mx;
+        bad += q - q;
+      }
+      float b = 0.F;
+      for (int l = 0; l < 4; ++l) {
+        lo[k] = std::min(lo[k], mn[l]);
+        hi[k] = std::max(hi[k], mx[l]);
+        b += bad[l];
+      }
+      for (std::size_t i = n4; i < n; ++i) {
+        lo[k] = std::min(lo[k], v[i]);
+        hi[k] = std::max(hi[k], v[i]);
+        b += v[i] - v[i];
+      }
+      finite = finite && b == 0.F;
+    }
   }
   const auto t = static_cast<float>(params_.tolerance_m);
   float extent = 0.F;  // largest coordinate magnitude: sets the rounding the cell edge must leave room for
@@ -263,6 +298,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   const double nz_d = finite && edge > 0.F ? static_cast<double>(hi[2] - lo[2]) / static_cast<double>(edge) : 0.0;
   if (!finite || !(edge > 0.F) || nx > max_cols || ny > max_cols || nx * ny > max_cols ||
       nz_d >= static_cast<double>(max_cols)) {
+    prepare(in);
     extract_kdtree(in, out);
     return;
   }
@@ -271,42 +307,40 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     return static_cast<std::uint32_t>(static_cast<std::int32_t>((v - origin) * inv));  // >= 0: v >= origin
   };
 
-  // Points sorted by x-y column and, within a column, by z cell: two stable counting sorts (by z cell, then
-  // by column), as an LSD radix sort.
+  // Points in grid order (by x-y column, and within a column by z cell): two stable counting sorts of point
+  // indices, by z cell and then by column, as an LSD radix sort. The column histogram goes two places up, so
+  // that after the scatter (which moves each column's cursor from its start to its end) col_start_[c] is
+  // column c's start.
   const std::size_t cols = nx * ny;
-  const std::size_t nz = static_cast<std::size_t>(nz_d) + 1;
-  col_start_.assign(std::max(cols, nz) + 1, 0U);
-  cell_of_.resize(n);  // z cell of each point, then its column
+  const auto nz_top = static_cast<std::uint32_t>(nz_d);
+  col_start_.assign(cols + 2, 0U);
+  z_start_.assign(std::size_t{nz_top} + 2, 0U);
+  cell_of_.resize(n);  // column of each point
+  z_of_.resize(n);     // z cell of each point
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t z = std::min<std::uint32_t>(cell(in.z[i], lo[2]), static_cast<std::uint32_t>(nz - 1));
-    cell_of_[i] = z;
-    ++col_start_[z + 1];
+    const std::size_t c = std::min<std::size_t>(cell(in.x[i], lo[0]), nx - 1) * ny +
+                          std::min<std::size_t>(cell(in.y[i], lo[1]), ny - 1);
+    const std::uint32_t z = std::min(cell(in.z[i], lo[2]), nz_top);
+    cell_of_[i] = static_cast<std::uint32_t>(c);
+    z_of_[i] = z;
+    ++col_start_[c + 2];
+    ++z_start_[z + 1];
   }
-  for (std::size_t z = 0; z < nz; ++z) col_start_[z + 1] += col_start_[z];
+  for (std::size_t c = 2; c < cols + 2; ++c) col_start_[c] += col_start_[c - 1];
+  for (std::size_t z = 1; z <= nz_top; ++z) z_start_[z] += z_start_[z - 1];
   by_z_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    by_z_[col_start_[cell_of_[i]]++] = GridPoint{in.x[i], in.y[i], in.z[i], static_cast<std::uint32_t>(i), cell_of_[i]};
-  }
-  std::fill(col_start_.begin(), col_start_.begin() + static_cast<std::ptrdiff_t>(cols) + 1, 0U);
-  for (std::size_t k = 0; k < n; ++k) {
-    const GridPoint& g = by_z_[k];
-    const std::size_t c =
-        std::min<std::size_t>(cell(g.x, lo[0]), nx - 1) * ny + std::min<std::size_t>(cell(g.y, lo[1]), ny - 1);
-    cell_of_[k] = static_cast<std::uint32_t>(c);
-    ++col_start_[c + 1];
-  }
-  for (std::size_t c = 0; c < cols; ++c) col_start_[c + 1] += col_start_[c];
-  grid_points_.resize(n);
-  col_next_.assign(col_start_.begin(), col_start_.begin() + static_cast<std::ptrdiff_t>(cols));
-  for (std::size_t k = 0; k < n; ++k) grid_points_[col_next_[cell_of_[k]]++] = by_z_[k];
+  for (std::size_t i = 0; i < n; ++i) by_z_[z_start_[z_of_[i]]++] = static_cast<std::uint32_t>(i);
+  grid_index_.resize(n);
+  for (const std::uint32_t i : by_z_) grid_index_[col_start_[cell_of_[i] + 1]++] = i;
+
   // Cells: runs of k z cells in a column. Far out the radii are larger than the cube's diagonal: a column whose
   // every point is at least rmin away (horizontally, so in 3D too) may stack k z cells into one taller cell
   // whose points still all join with the smallest radii at rmin (each axis's extent taken 2 * rounding long).
-  // Fewer, taller cells: far walls cost fewer cell pairs.
-  cells_.clear();
-  col_cells_.resize(cols + 1);
-  GridPoint* gp = grid_points_.data();
+  // Fewer, taller cells: far walls cost fewer cell pairs. One pass over the columns copies their points into grid
+  // order (coordinates and radii, one array each, padded by four: the pair test reads four at a time) and makes
+  // their cells with their point boxes and largest radii.
   const double e = static_cast<double>(edge), rho2 = 2.0 * static_cast<double>(rounding);
+  const RadiusModel rm = radius_model();
   const auto stack_of = [&](std::size_t c) -> std::uint32_t {
     if (!adaptive_) return 1;
     const double x0 = static_cast<double>(lo[0]) + static_cast<double>(c / ny) * e - rho2;
@@ -314,194 +348,173 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     const double dx = std::max({0.0, x0, -(x0 + e + 2.0 * rho2)});
     const double dy = std::max({0.0, y0, -(y0 + e + 2.0 * rho2)});
     const auto rmin = static_cast<float>(std::sqrt(dx * dx + dy * dy));
-    const auto v = static_cast<double>(grown(growth_, cap_, rmin));
-    const double h = anisotropic_ ? static_cast<double>(grown(growth_h_, cap_h_, rmin)) : v;
+    const auto v = static_cast<double>(rm.v(rmin));
+    const auto h = static_cast<double>(rm.h(rmin));
     const double across = 2.0 * (e + rho2) * (e + rho2) / (h * h);
     if (!(across < 0.998)) return 1;
     const double height = std::sqrt((0.998 - across) * v * v) - rho2;  // the tallest cell allowed
     return static_cast<std::uint32_t>(std::clamp(std::floor(height / e), 1.0, 64.0));
   };
+  grid_xyz_.resize(5 * (n + 4));
+  float* const sx = grid_xyz_.data();
+  float* const sy = sx + n + 4;
+  float* const sz = sy + n + 4;
+  float* const r2 = sz + n + 4;  // vertical radius squared (the only one unless anisotropic)
+  float* const h2 = anisotropic_ ? r2 + n + 4 : r2;
+  cells_.resize(n + 1);  // at most a cell a point, and the end sentinel
+  cell_z_.resize(n);
+  cell_box_.resize(6 * n);
+  col_cells_.resize(cols + 1);
+  Cell* const cl = cells_.data();
+  ZSpan* const zspan = cell_z_.data();
+  float* const boxes = cell_box_.data();
+  std::uint32_t ncells = 0;
   for (std::size_t c = 0; c < cols; ++c) {
-    col_cells_[c] = static_cast<std::uint32_t>(cells_.size());
+    col_cells_[c] = ncells;
     const std::uint32_t b = col_start_[c], end = col_start_[c + 1];
     if (b == end) continue;
     const std::uint32_t k = stack_of(c);
     std::uint32_t top = 0;  // the last z cell of the current cell
+    Cell* cur = nullptr;
+    float* box = nullptr;
     for (std::uint32_t j = b; j < end; ++j) {
-      if (j == b || gp[j].iz > top) {
-        const std::uint32_t bottom = gp[j].iz - gp[j].iz % k;
+      const std::uint32_t i = grid_index_[j], iz = z_of_[i];
+      const float x = in.x[i], y = in.y[i], z = in.z[i];
+      sx[j] = x;
+      sy[j] = y;
+      sz[j] = z;
+      float range = 0.F, v2 = base_r2_, hv2 = base_r2_;
+      if (adaptive_) {
+        range = std::sqrt(x * x + y * y + z * z);
+        v2 = rm.squared(rm.v(range));
+        hv2 = rm.squared(rm.h(range));
+      }
+      r2[j] = v2;
+      h2[j] = hv2;
+      if (j == b || iz > top) {
+        const std::uint32_t bottom = iz - iz % k;
         top = bottom + k - 1;
-        cells_.push_back(Cell{j, static_cast<std::uint32_t>(c), bottom, top, 0.F, 0.F});
+        cur = cl + ncells;
+        *cur = Cell{j, static_cast<std::uint32_t>(c), v2, hv2, range};
+        zspan[ncells] = ZSpan{bottom, top};
+        box = boxes + 6 * static_cast<std::size_t>(ncells);
+        box[0] = box[3] = x;
+        box[1] = box[4] = y;
+        box[2] = box[5] = z;
+        ++ncells;
+        continue;
       }
+      box[0] = std::min(box[0], x);
+      box[1] = std::min(box[1], y);
+      box[2] = std::min(box[2], z);
+      box[3] = std::max(box[3], x);
+      box[4] = std::max(box[4], y);
+      box[5] = std::max(box[5], z);
+      // Both radii grow with range: the cell's farthest point has its largest of each.
+      cur->reach2 = std::max(cur->reach2, v2);
+      cur->hreach2 = std::max(cur->hreach2, hv2);
+      cur->range = std::max(cur->range, range);
     }
   }
-  col_cells_[cols] = static_cast<std::uint32_t>(cells_.size());
-  const auto ncells = static_cast<std::uint32_t>(cells_.size());
-  cells_.push_back(Cell{static_cast<std::uint32_t>(n), 0, 0, 0, 0.F, 0.F});  // sentinel: the end of the last cell
-  sorted_r2_.resize(n + 4);  // padded: the pair test reads four at a time
-  if (anisotropic_) sorted_h2_.resize(n + 4);
+  col_cells_[cols] = ncells;
+  cl[ncells].first = static_cast<std::uint32_t>(n);  // sentinel: the end of the last cell
+  for (std::size_t j = n; j < n + 4; ++j) sx[j] = sy[j] = sz[j] = r2[j] = h2[j] = 0.F;
+
+  // Joins. Each cell looks back at the cells before it in cell order (x column, y column, z) within its
+  // stencil: a half-space, so each cell pair is looked at once. The other cell's radii may be the larger, so
+  // the stencil holds every cell a point of this one may join at all: a point at range R joins only points
+  // within D = max(its own radii, min(cap, g R / (1 - g))) (as the k-d tree's search radius, see prepare), so
+  // the pair's radii are at most those at R + D, R the cell's farthest point. The box pretest and the point
+  // test then take each pair's own radii. Dense surfaces join early and most pairs end at the union-find check.
   parent_.resize(ncells);
-  cell_box_.resize(6 * static_cast<std::size_t>(ncells));
-  for (std::uint32_t c = 0; c < ncells; ++c) {
-    parent_[c] = c;
-    float m = base_r2_, mh = base_r2_;
-    float* box = cell_box_.data() + 6 * static_cast<std::size_t>(c);
-    const GridPoint& p0 = gp[cells_[c].first];
-    box[0] = box[3] = p0.x;
-    box[1] = box[4] = p0.y;
-    box[2] = box[5] = p0.z;
-    for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) {
-      box[0] = std::min(box[0], gp[j].x);
-      box[1] = std::min(box[1], gp[j].y);
-      box[2] = std::min(box[2], gp[j].z);
-      box[3] = std::max(box[3], gp[j].x);
-      box[4] = std::max(box[4], gp[j].y);
-      box[5] = std::max(box[5], gp[j].z);
-      const float r2 = adaptive_ ? r2_[gp[j].index] : base_r2_;
-      sorted_r2_[j] = r2;
-      m = std::max(m, r2);
-      if (anisotropic_) {
-        sorted_h2_[j] = h2_[gp[j].index];
-        mh = std::max(mh, sorted_h2_[j]);
-      }
-    }
-    // Anisotropic: both radii grow with range, so of a joining pair the farther point has the larger of each
-    // and reaches the other within its cell's largest horizontal (hreach2) and vertical (reach2) radius.
-    cells_[c].reach2 = m;
-    cells_[c].hreach2 = anisotropic_ ? mh : m;
-  }
-
-  // Joins. Of two cells, the one with the larger radii (both radii grow with range, so a cell's largest
-  // horizontal and vertical radius are those of its farthest point: of two cells, one has both at least as
-  // large as the other's; ties by cell number) looks for the other within its own reach. Its reach covers
-  // every pair the other's would, so each cell pair is looked at once, from that side; of two points, the one
-  // with the larger radius reaches the other, so every joining pair is tested. Dense surfaces join early and
-  // most pairs end at the union-find check.
-  std::uint32_t* parent = parent_.data();
-  const float* r2 = sorted_r2_.data();
-  const float* h2 = anisotropic_ ? sorted_h2_.data() : sorted_r2_.data();
+  std::uint32_t* const parent = parent_.data();
+  for (std::uint32_t c = 0; c < ncells; ++c) parent[c] = c;
   const bool aniso = anisotropic_;
-  // The gap between two cells `d` apart on an axis (a whole cell less, taken short by kSlack), for every
-  // offset a cell's reach covers: looked up per neighbour instead of computed.
-  float max_reach2 = 0.F;
-  for (std::uint32_t c = 0; c < ncells; ++c) max_reach2 = std::max({max_reach2, cells_[c].reach2, cells_[c].hreach2});
-  const auto max_reach = static_cast<std::int64_t>(std::sqrt(max_reach2) / edge) + 1;
-  gaps_.resize(static_cast<std::size_t>(2 * max_reach + 1));
-  for (std::int64_t d = -max_reach; d <= max_reach; ++d) {
-    const std::int64_t g = d < 0 ? -d - 1 : d - 1;
-    gaps_[static_cast<std::size_t>(d + max_reach)] = g > 0 ? static_cast<float>(g) * edge - kSlack : 0.F;
-  }
-  const float* gap_at = gaps_.data() + max_reach;  // gap_at[d], d in [-max_reach, max_reach]
-  // Points in grid order, one array per coordinate (padded: the pair test reads four at a time).
-  grid_xyz_.resize(3 * (n + 4));
-  float* const sx = grid_xyz_.data();
-  float* const sy = sx + n + 4;
-  float* const sz = sy + n + 4;
-  for (std::size_t j = 0; j < n; ++j) {
-    sx[j] = gp[j].x;
-    sy[j] = gp[j].y;
-    sz[j] = gp[j].z;
-  }
-  for (std::size_t j = n; j < n + 4; ++j) sx[j] = sy[j] = sz[j] = 0.F;
-  for (std::size_t j = n; j < n + 4; ++j) {
-    sorted_r2_[j] = 0.F;
-    if (anisotropic_) sorted_h2_[j] = 0.F;
-  }
-  // Whether cell b's radii are below cell a's (the order above: vertical, then horizontal, then number).
-  const auto below = [&](const Cell& cb, std::uint32_t b, const Cell& ca, std::uint32_t a) {
-    if (cb.reach2 != ca.reach2) return cb.reach2 < ca.reach2;
-    if (cb.hreach2 != ca.hreach2) return cb.hreach2 < ca.hreach2;
-    return b < a;
-  };
-  // Per column: its lowest cell in that order (col_next_ is free until the clusters are grouped). A column whose
-  // lowest cell is not below a has no cell a looks for: a passes over it whole. (Radii grow with range, so most
-  // columns on a's far side.)
-  std::uint32_t* const col_low = col_next_.data();
-  for (std::uint32_t b = 0; b < ncells; ++b) {
-    const std::uint32_t col = cells_[b].col, low = col_low[col];
-    if (b == col_cells_[col] || below(cells_[b], b, cells_[low], low)) col_low[col] = b;
-  }
+  const float gq = anisotropic_ ? std::max(growth_, growth_h_) : growth_;
+  const float capq = anisotropic_ ? std::max(cap_, cap_h_) : cap_;
+  const float gq_reach = gq / (1.F - gq);
+  const ZSpan* const zs = cell_z_.data();
   for (std::uint32_t a = 0; a < ncells; ++a) {
-    const Cell& ca = cells_[a];
-    const std::uint32_t a0 = ca.first, a1 = cells_[a + 1].first;
-    const float reach2 = ca.reach2, hreach2 = ca.hreach2;  // equal unless anisotropic
-    const auto reach = static_cast<std::int64_t>(std::sqrt(reach2) / edge) + 1;
-    const auto hreach = static_cast<std::int64_t>(std::sqrt(hreach2) / edge) + 1;
-    const auto ax = static_cast<std::int64_t>(ca.col / ny), ay = static_cast<std::int64_t>(ca.col % ny);
-    const auto az = static_cast<std::int64_t>(ca.iz), az_top = static_cast<std::int64_t>(ca.iz_top);
-    // Whether a cell dz z cells away in a column gxy away is within reach. It only turns false as |dz| grows
-    // (the gap grows with the offset), so a column's reachable cells are one run of z cells.
-    const auto within = [&](float gxy, std::int64_t dz) {
-      const float gz = gap_at[dz];
-      return aniso ? joins_anisotropic(gxy, gz * gz, hreach2, reach2) : gxy + gz * gz < reach2;
-    };
-    std::uint32_t ra = find_root(parent, a);  // kept up to date: only this loop joins a's root to another
-    const float* const abox = cell_box_.data() + 6 * static_cast<std::size_t>(a);
-    for (std::int64_t x = std::max<std::int64_t>(0, ax - hreach);
-         x <= std::min<std::int64_t>(ax + hreach, static_cast<std::int64_t>(nx) - 1); ++x) {
-      const float gx = gap_at[x - ax];
-      for (std::int64_t y = std::max<std::int64_t>(0, ay - hreach);
-           y <= std::min<std::int64_t>(ay + hreach, static_cast<std::int64_t>(ny) - 1); ++y) {
-        const auto col = static_cast<std::size_t>(x) * ny + static_cast<std::size_t>(y);
-        std::uint32_t b = col_cells_[col];
-        const std::uint32_t last = col_cells_[col + 1];
-        if (b == last) continue;  // an empty column (most are)
-        const std::uint32_t low = col_low[col];
-        if (!below(cells_[low], low, ca, a)) continue;
-        const float gy = gap_at[y - ay];
-        const float gxy = gx * gx + gy * gy;
-        if (!(gxy < hreach2) || !within(gxy, 0)) continue;
-        // The largest |dz| within reach: first guessed from the ellipse (the gap of d cells is (d - 1) * edge),
-        // then settled by the test itself, so exactly the run the test allows.
-        const float room2 = aniso ? reach2 * (1.F - gxy / hreach2) : reach2 - gxy;
-        std::int64_t lim = room2 > 0.F ? static_cast<std::int64_t>(std::sqrt(room2) * inv) + 1 : 0;
-        lim = std::min(lim, reach);
-        while (lim > 0 && !within(gxy, lim)) --lim;
-        while (lim < reach && within(gxy, lim + 1)) ++lim;
-        const auto z_lo = az - lim, z_hi = az_top + lim;
-        while (b < last && static_cast<std::int64_t>(cells_[b].iz_top) < z_lo) ++b;
-        for (; b < last; ++b) {
-          const Cell& cb = cells_[b];
-          if (static_cast<std::int64_t>(cb.iz) > z_hi) break;  // cells of a column ascend in z
-          // b looks for a (or b is a)
-          if (!below(cb, b, ca, a)) continue;
-          const std::uint32_t rb = find_root(parent, b);
-          if (ra == rb) continue;
-          // The gap between the two cells' point boxes on each axis, taken short by kSlack: no two of their
-          // points are nearer. Beyond a's radii there (b's are no larger), none of their pairs joins: many cells
-          // a column's z run reaches only by the lattice (a far wall's tall cells, its edge columns) end here.
-          const float* const bbox = cell_box_.data() + 6 * static_cast<std::size_t>(b);
-          const auto box_gap = [&](int k) {
-            return std::max(0.F, std::max(bbox[k] - abox[k + 3], abox[k] - bbox[k + 3]) - kSlack);
-          };
-          const float bx = box_gap(0), by = box_gap(1), bz = box_gap(2);
-          const float bxy2 = bx * bx + by * by;
-          if (!(aniso ? joins_anisotropic(bxy2, bz * bz, hreach2, reach2) : bxy2 + bz * bz < reach2)) continue;
-          if (cells_join(a0, a1, cb.first, cells_[b + 1].first, sx, sy, sz, r2, h2, aniso)) {
-            parent[std::max(ra, rb)] = std::min(ra, rb);
-            ra = std::min(ra, rb);
-          }
-        }
+    const Cell& ca = cl[a];
+    float hs = t, vs = t;  // the stencil's horizontal and vertical radius
+    if (adaptive_) {
+      const float far = ca.range + std::max(std::max(rm.v(ca.range), rm.h(ca.range)),
+                                            std::min(capq, gq_reach * ca.range));
+      hs = rm.h(far);
+      vs = rm.v(far);
+    }
+    // Cells up to this many apart on an axis may hold points within the radius there: the gap between two
+    // cells d apart is (d - 1) edges (less rounding, under kSlack).
+    const auto hreach = static_cast<std::uint32_t>((hs + kSlack) * inv) + 1;
+    const auto reach = static_cast<std::uint32_t>((vs + kSlack) * inv) + 1;
+    const std::uint32_t ax = ca.col / static_cast<std::uint32_t>(ny), ay = ca.col % static_cast<std::uint32_t>(ny);
+    const std::uint32_t z_lo = zs[a].iz > reach ? zs[a].iz - reach : 0U, z_hi = zs[a].iz_top + reach;
+    const std::size_t y0 = ay > hreach ? ay - hreach : 0U;
+    const std::size_t y1 = std::min<std::size_t>(std::size_t{ay} + hreach, ny - 1);
+    const std::uint32_t a0 = ca.first, a1 = cl[a + 1].first;
+    // a is still alone (only cells after it look at it): its first join is found by geometry, and after that most
+    // cells fail the union-find check. So the nearest cells first: a's own row backwards from a (the cells below
+    // it in its column, then the columns before), then the rows before it.
+    std::uint32_t ra = a;  // a's root, kept up to date: only this loop joins it to another now
+    const float* const abox = boxes + 6 * static_cast<std::size_t>(a);
+    // Forced inline: three loops call it, and as a call (what g++ chose) the stage took 18% more instructions.
+    const auto visit = [&](std::uint32_t b) __attribute__((always_inline)) {
+      if (zs[b].iz > z_hi || zs[b].iz_top < z_lo) return;
+      const std::uint32_t rb = find_root(parent, b);
+      if (ra == rb) return;
+      // The gap between the two cells' point boxes on each axis, taken short by kSlack: no two of their points
+      // are nearer. Beyond the two cells' largest radii there, none of their pairs joins: many cells the
+      // stencil's corners reach end here.
+      const Cell& cb = cl[b];
+      const float* const bbox = boxes + 6 * static_cast<std::size_t>(b);
+      const auto box_gap = [&](int i) {
+        return std::max(0.F, std::max(bbox[i] - abox[i + 3], abox[i] - bbox[i + 3]) - kSlack);
+      };
+      const float bx = box_gap(0), by = box_gap(1), bz = box_gap(2);
+      const float bxy2 = bx * bx + by * by;
+      const float v2 = std::max(ca.reach2, cb.reach2);
+      if (!(aniso ? joins_anisotropic(bxy2, bz * bz, std::max(ca.hreach2, cb.hreach2), v2) : bxy2 + bz * bz < v2)) {
+        return;
       }
+      if (cells_join(a0, a1, cb.first, cl[b + 1].first, sx, sy, sz, r2, h2, aniso)) {
+        parent[std::max(ra, rb)] = std::min(ra, rb);
+        ra = std::min(ra, rb);
+      }
+    };
+    const std::uint32_t own = col_cells_[ca.col];  // a's column: ascending in z, so below z_lo it is done
+    for (std::uint32_t b = a; b > own && zs[b - 1].iz_top >= z_lo;) visit(--b);
+    for (std::uint32_t b = own, first = col_cells_[std::size_t{ax} * ny + y0]; b > first;) visit(--b);
+    for (std::uint32_t x = ax > hreach ? ax - hreach : 0U; x < ax; ++x) {
+      const std::size_t row = std::size_t{x} * ny;
+      for (std::uint32_t b = col_cells_[row + y0], last = col_cells_[row + y1 + 1]; b < last; ++b) visit(b);
     }
   }
 
-  // Clusters in the order of their lowest point index, members ascending: one pass in index order.
-  // A cell's parent is never after it (a join points the later root at the earlier one, and path halving
-  // at an ancestor), so one pass in cell order points every cell at its root.
-  cluster_of_root_.assign(ncells, kNoCluster);
+  // Clusters in the order of their lowest point index, members ascending. A cell's parent is never after it
+  // (a join points the later root at the earlier one, and path halving at an ancestor), so one pass in cell
+  // order points every cell at its root and adds its size to the root's. Then one pass over the points in
+  // index order: a root first met opens the next cluster (its offset known from the size), and each point goes
+  // to its root's next slot.
+  root_size_.assign(ncells, 0U);
   pos_of_.resize(n);  // root cell of each point
   for (std::uint32_t c = 0; c < ncells; ++c) {
     parent[c] = parent[parent[c]];
-    for (std::uint32_t j = cells_[c].first; j < cells_[c + 1].first; ++j) pos_of_[gp[j].index] = parent[c];
+    root_size_[parent[c]] += cl[c + 1].first - cl[c].first;
+    for (std::uint32_t j = cl[c].first; j < cl[c + 1].first; ++j) pos_of_[grid_index_[j]] = parent[c];
   }
-  std::uint32_t clusters = 0;
+  cluster_of_root_.assign(ncells, kNoCluster);  // then the root's next slot in out.indices
+  out.indices.resize(n);
+  std::uint32_t opened = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t& id = cluster_of_root_[pos_of_[i]];
-    if (id == kNoCluster) id = clusters++;
-    cell_of_[i] = id;
+    const std::uint32_t r = pos_of_[i];
+    std::uint32_t& slot = cluster_of_root_[r];
+    if (slot == kNoCluster) {
+      slot = opened;
+      opened += root_size_[r];
+      out.offsets.push_back(opened);
+    }
+    out.indices[slot++] = static_cast<std::uint32_t>(i);
   }
-  group_points({cell_of_.data(), n}, clusters, kNoCluster, out, col_next_);
 }
 
 void group_points(std::span<const std::uint32_t> cluster_of_point, std::uint32_t count, std::uint32_t none,

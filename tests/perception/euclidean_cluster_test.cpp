@@ -529,6 +529,67 @@ TEST(EuclideanClusterer, AnisotropicKeepsAFarPersonOneCluster) {
   }
 }
 
+// The grid's bounds pass tells non-finite coordinates by x - x (0 only for a finite x): an infinity on any axis,
+// alone or beside finite points, also sends the cloud to the k-d tree, with the same clusters.
+TEST(EuclideanClusterer, GridWithInfinitePointsMatchesTheKdTree) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const float bad : {kInf, -kInf}) {
+      Cloud c = two_boxes(0.5F);
+      float p[3] = {5.2F, 0.2F, 0.2F};
+      p[axis] = bad;
+      c.push_back(p[0], p[1], p[2]);
+      c.push_back(5.2F, 0.3F, 0.2F);
+      Clusters a, b;
+      EuclideanClusterer kd(params(ClusterMethod::Fixed, ClusterStructure::KdTree));
+      EuclideanClusterer grid(params(ClusterMethod::Fixed, ClusterStructure::Grid));
+      kd.extract(c, a);
+      grid.extract(c, b);
+      EXPECT_EQ(sets_of(a), sets_of(b)) << axis << " " << bad;
+      EXPECT_EQ(b.size(), 2U) << axis << " " << bad;  // the boxes with the last point, and the infinite one
+    }
+  }
+}
+
+// Each grid cell looks back (in cell order) at the cells before it, so a pair may be found only from the side
+// with the smaller radii: its stencil must reach as far as the other side's larger radius. With a 0.1 m
+// tolerance (cells of about 0.057 m) and points straight below or above the sensor (range = |z|), a pair 30 m
+// down joins at 0.98 of the lower point's vertical radius, 2.7 m, which is beyond the upper point's own radius
+// (2.54 m at 27.3 m) by more than three cells; at 1.02 it stays apart. Above the sensor the farther point is the
+// later cell. Also sideways (x negative: the farther point comes first in cell order) and for both growing radii.
+TEST(EuclideanClusterer, GridReachesTheLargerRadiusOfAnEarlierCell) {
+  for (const auto method : {ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
+    const EuclideanClusterer probe(params(method, ClusterStructure::Grid, 0.1));
+    for (const float far : {12.F, 20.F, 30.F}) {
+      for (const float factor : {0.98F, 1.02F}) {
+        for (const int dir : {0, 1, 2}) {  // down, up, along -x
+          Cloud c;
+          const float v = probe.radius_at(far), h = probe.horizontal_radius_at(far);
+          if (dir == 0) {
+            c.push_back(0.F, 0.F, -far);
+            c.push_back(0.F, 0.F, -far + factor * v);
+          } else if (dir == 1) {
+            c.push_back(0.F, 0.F, far);
+            c.push_back(0.F, 0.F, far - factor * v);
+          } else {
+            c.push_back(-far, 0.F, 0.F);
+            c.push_back(-far + factor * h, 0.F, 0.F);
+          }
+          c.push_back(-far, 40.F, 0.F);  // far aside: a singleton that widens the grid
+          for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+            EuclideanClusterer e(params(method, structure, 0.1));
+            Clusters out;
+            e.extract(c, out);
+            EXPECT_EQ(out.size(), factor < 1.F ? 2U : 3U)
+                << method_name(method) << " " << far << " " << factor << " dir " << dir
+                << (structure == ClusterStructure::Grid ? " grid" : " kd");
+          }
+        }
+      }
+    }
+  }
+}
+
 // Just inside and just outside the ellipse at 5 m: the vertical radius is 4 * 5 * tan(1.33 deg) = 0.465 m, the
 // horizontal one 0.4 m (its floor). (0.30, 0.27) is 0.404 m away: outside a 0.4 m sphere, inside the ellipse.
 TEST(EuclideanClusterer, AnisotropicEllipseBoundary) {

@@ -9,9 +9,9 @@
 // vertical radius, both growing with range; two points join inside the ellipsoid (dxy / H)^2 + (dz / V)^2 < 1
 // with H and V the larger of their horizontal and vertical radii (again symmetric). Structures: KdTree (our k-d
 // tree, the published way) or Grid (cells small enough that a cell's points always join: cubes, stacked into taller
-// cells far out where the radii allow; union-find over cells, each pair of cells within reach looked at once, from
-// the side with the larger radii, and joined by their first pair within reach, tested four at a time). Both find
-// exactly the same clusters.
+// cells far out where the radii allow; union-find over cells, each cell looking back at the cells before it within
+// a stencil that covers both sides' radii, so each pair is looked at once, nearest first, and joined by their first
+// pair within reach, tested four at a time). Both find exactly the same clusters.
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
 
@@ -71,6 +71,8 @@ class EuclideanClusterer {
   void extract_grid(const Cloud& in, Clusters& out);
   void finish_cluster(Clusters& out);
   [[nodiscard]] float grown(float growth, float cap, float range_m) const;
+  struct RadiusModel;  // the radii, for the hot loops (euclidean_cluster.cpp)
+  [[nodiscard]] RadiusModel radius_model() const;
   // Inside the ellipsoid of horizontal radius sqrt(h2), vertical sqrt(v2): dxy2 / h2 + dz2 / v2 < 1, without
   // dividing.
   static bool joins_anisotropic(float dxy2, float dz2, float h2, float v2) { return dxy2 * v2 + dz2 * h2 < h2 * v2; }
@@ -92,35 +94,34 @@ class EuclideanClusterer {
   Buffer<std::uint8_t> done_;
   Buffer<std::uint32_t> queue_;
   Buffer<std::uint32_t> pos_of_;  // cloud index -> position in the structure's order
-  Buffer<std::uint32_t> col_start_;
-  Buffer<std::uint32_t> cell_of_;
-  struct GridPoint {
-    float x, y, z;
-    std::uint32_t index;
-    std::uint32_t iz;  // z cell
-  };
+  // Grid (extract_grid), reused across frames.
+  Buffer<std::uint32_t> col_start_;   // per x-y column: its first point in grid order
+  Buffer<std::uint32_t> z_start_;     // per z cell: its first point in z order
+  Buffer<std::uint32_t> cell_of_;     // per point: its x-y column
+  Buffer<std::uint32_t> z_of_;        // per point: its z cell
+  Buffer<std::uint32_t> by_z_;        // point indices in z order
+  Buffer<std::uint32_t> grid_index_;  // grid order -> point index
+  Buffer<float> grid_xyz_;            // x, y, z, vertical and horizontal radius squared in grid order, one array each
   struct Cell {
-    std::uint32_t first;   // its points: grid_points_[first, next cell's first)
+    std::uint32_t first;   // its points: grid order [first, next cell's first)
     std::uint32_t col;     // x-y column
-    std::uint32_t iz;      // its lowest z cell
-    std::uint32_t iz_top;  // its highest z cell (far out a cell stacks several: see extract_grid)
     float reach2;          // the largest radius of its points, squared (anisotropic: the vertical one)
     float hreach2;         // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
+    float range;           // adaptive: the 3D range of its farthest point
   };
   static constexpr std::uint32_t kNoCluster = 0xFFFFFFFFU;
-  Buffer<GridPoint> grid_points_;
-  Buffer<GridPoint> by_z_;          // the points sorted by z cell (the first radix pass)
-  Buffer<float> sorted_r2_;         // r2_ in grid order
-  Buffer<float> sorted_h2_;         // h2_ in grid order (anisotropic)
-  Buffer<float> grid_xyz_;          // x, y, z of the points in grid order, one array each
-  Buffer<std::uint32_t> col_next_;  // scratch: per column, then per cluster
   Buffer<Cell> cells_;
+  struct ZSpan {  // per cell, apart: the neighbour scan reads only these, packed
+    std::uint32_t iz;      // its lowest z cell
+    std::uint32_t iz_top;  // its highest z cell (far out a cell stacks several: see extract_grid)
+  };
+  Buffer<ZSpan> cell_z_;
+  Buffer<float> cell_box_;           // per cell, the box of its points (min x, y, z, max x, y, z)
   Buffer<std::uint32_t> col_cells_;  // per column: its first cell (cells of a column ascend in z)
   Buffer<std::uint32_t> parent_;     // union-find over cells
+  Buffer<std::uint32_t> root_size_;  // per root cell: its cluster's size
   Buffer<std::uint32_t> cluster_of_root_;
-  Buffer<std::uint8_t> mark_;
-  Buffer<float> gaps_;      // grid: the gap between cells per offset
-  Buffer<float> cell_box_;  // grid: per cell, the box of its points (min x, y, z, max x, y, z)
+  Buffer<std::uint8_t> mark_;  // k-d tree: finish_cluster's bitmap
 };
 
 }  // namespace fieldguard::perception
