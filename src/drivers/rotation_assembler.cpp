@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 namespace fieldguard {
@@ -177,29 +178,43 @@ void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stam
   have_current_ = have;
 }
 
-bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sensor_time, AzimuthRange azimuths) {
-  const std::size_t size = current_.points.size();
-  const std::size_t end = count_ + std::min(count, size - std::min(count_, size));
+std::optional<double> RotationAssembler::in_frame_offset_s(AzimuthRange azimuths, Stamp packet_sensor_time) const {
   const int cut = cut_cdeg_;
   const int prev = prev_rel_cdeg_;
-  if (!have_current_ || prev < 0 || end == count_) return false;
-  if (azimuths.min_cdeg > azimuths.max_cdeg || azimuths.max_cdeg >= kFullTurnCdeg) return false;
+  if (!have_current_ || prev < 0) return std::nullopt;
+  if (azimuths.min_cdeg > azimuths.max_cdeg || azimuths.max_cdeg >= kFullTurnCdeg) return std::nullopt;
   // The azimuth relative to the cut rises with the azimuth over the bounds only if the cut is not inside them.
-  if (azimuths.min_cdeg < cut && cut <= azimuths.max_cdeg) return false;
+  if (azimuths.min_cdeg < cut && cut <= azimuths.max_cdeg) return std::nullopt;
   const int lo = std::min(relative_cdeg(azimuths.min_cdeg, cut), prev);
   const int hi = std::max(relative_cdeg(azimuths.max_cdeg, cut), prev);
   // commit() cuts where an azimuth falls more than half a turn below the previous one, and holds the reference back
   // where one lies more than half a turn above it. Neither can happen while every azimuth of the packet and the
   // reference lie within half a turn of each other: every point then just becomes the reference, the last one last.
-  if (hi - lo > kWrapCdeg) return false;
-  LidarPoint* const pts = current_.points.data();
-  const double packet_to_frame_s = static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
-  for (std::size_t i = count_; i < end; ++i) {
-    pts[i].time_s = static_cast<float>(packet_to_frame_s + static_cast<double>(pts[i].time_s));
-  }
+  if (hi - lo > kWrapCdeg) return std::nullopt;
+  return static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
+}
+
+void RotationAssembler::commit_in_frame(std::size_t count) {
+  const std::size_t size = current_.points.size();
+  const std::size_t end = count_ + std::min(count, size - std::min(count_, size));
+  // No point: nothing happens, as in commit() (the packet is not counted).
+  if (end == count_) return;
   ++current_.packets;
-  prev_rel_cdeg_ = relative_cdeg(pts[end - 1].azimuth_cdeg, cut);
+  prev_rel_cdeg_ = relative_cdeg(current_.points[end - 1].azimuth_cdeg, cut_cdeg_);
   count_ = end;
+}
+
+bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sensor_time, AzimuthRange azimuths) {
+  const std::size_t size = current_.points.size();
+  const std::size_t end = count_ + std::min(count, size - std::min(count_, size));
+  if (end == count_) return false;
+  const std::optional<double> packet_to_frame_s = in_frame_offset_s(azimuths, packet_sensor_time);
+  if (!packet_to_frame_s) return false;
+  LidarPoint* const pts = current_.points.data();
+  for (std::size_t i = count_; i < end; ++i) {
+    pts[i].time_s = static_cast<float>(*packet_to_frame_s + static_cast<double>(pts[i].time_s));
+  }
+  commit_in_frame(count);
   return true;
 }
 

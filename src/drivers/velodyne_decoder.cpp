@@ -14,19 +14,22 @@
 
 #include "drivers/velodyne_decoder_kernels.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>  // baseline x86-64: two conversions and a sign mask the vector extension lowers badly
+#endif
+
 namespace fieldguard::velodyne {
 
 namespace {
 
 using kernels::AzimuthEntry;
 using kernels::azimuth_ring_word;
-using kernels::azimuth_word;
 using kernels::azimuth_table;
 using kernels::load4;
 using kernels::load_le16_unchecked;
 using kernels::load_le32_unchecked;
 using kernels::put_point;
-using kernels::round_cdeg32;
+using kernels::put_point_at;
 using kernels::round_cdeg_lround;
 using kernels::return_type_word;
 using kernels::ring_word;
@@ -34,7 +37,6 @@ using kernels::transpose4;
 using kernels::Vec4f;
 using kernels::Vec4i;
 using kernels::wrap_cdeg;
-using kernels::wrap_cdeg_fast;
 
 constexpr std::uint16_t kBlockFlag = 0xEEFF;  // FF EE on the wire, loaded little-endian
 constexpr std::uint16_t kAzimuthUnits = 36000;
@@ -154,6 +156,8 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
     slots_.block_fraction[slot] = in_block_us / lay.block_us;
     slots_.ring[slot] = static_cast<std::uint16_t>(ring < 0 ? 0 : ring);
     slots_.ring_word[slot] = ring_word(slots_.ring[slot]);
+    slots_.vert_offset_sin[slot] = slots_.vert_offset_m[slot] * slots_.sin_vert[slot];
+    slots_.vert_offset_cos[slot] = slots_.vert_offset_m[slot] * slots_.cos_vert[slot];
     if (!(std::abs(slots_.rot_cdeg[slot]) < 35000.F)) fast_wrap_ = false;
   }
   min_rot_cdeg_ = *std::min_element(slots_.rot_cdeg.begin(), slots_.rot_cdeg.end());
@@ -175,251 +179,353 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
 
 namespace {
 
-// The returns of one block, slot by slot, and the points they make (structure of arrays: the loops over them
-// are plain arithmetic with a constant trip count, which the compiler vectorises at -O2 with baseline SSE2).
-struct BlockPoints {
-  alignas(16) std::array<std::int32_t, kSlotsPerBlock> raw;
-  alignas(16) std::array<std::int32_t, kSlotsPerBlock> intensity;
-  alignas(16) std::array<std::int32_t, kSlotsPerBlock> ok;  // 1: a return inside the range limits
-  alignas(16) std::array<float, kSlotsPerBlock> intensity_f;
-  alignas(16) std::array<float, kSlotsPerBlock> range;
-  alignas(16) std::array<float, kSlotsPerBlock> x;
-  alignas(16) std::array<float, kSlotsPerBlock> y;
-  alignas(16) std::array<float, kSlotsPerBlock> z;
+inline Vec4f splat(float v) { return Vec4f{v, v, v, v}; }
+inline Vec4i splat_i(std::int32_t v) { return Vec4i{v, v, v, v}; }
+inline Vec4i load4i(const void* p) {
+  Vec4i v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+using Vec4u = std::uint32_t __attribute__((vector_size(16)));
+inline Vec4f bits_as_float(const Vec4i& v) {
+  Vec4f f;
+  std::memcpy(&f, &v, sizeof f);
+  return f;
+}
+
+// The angles of four slots of a firing group: azimuth cos/sin and the (azimuth, ring) words of the points.
+struct Angles4 {
+  Vec4f cos_a;
+  Vec4f sin_a;
+  Vec4i azimuth_ring;
 };
 
-// Azimuth, its cos/sin and the firing time of each slot of a firing group.
-struct GroupAngles {
-  alignas(16) std::array<float, kSlotsPerBlock> cos_a;
-  alignas(16) std::array<float, kSlotsPerBlock> sin_a;
-  // The firing time of each slot: the group's row of Decoder::group_time_s_.
-  const float* time_s;
-  alignas(16) std::array<std::uint32_t, kSlotsPerBlock> azimuth_ring;  // azimuth_ring_word() of each slot
+// The returns of four slots of one block and their points (before the time, azimuth and type are added).
+struct Returns4 {
+  Vec4f x, y, z, intensity, range;
+  Vec4i ok;    // -1 (all bits): a return inside the range limits; 0: none
+  Vec4i echo;  // distance and reflectivity bytes as they came: two blocks carry the same echo where these are equal
 };
+
+// Four points as LidarPoints: the two 16-byte halves of each (kernels::put_point()), by two 4 x 4 transposes of
+// the rows (x, y, z, intensity) and (time, range, (azimuth, ring) word, return_type_word()).
+struct Rows {
+  Vec4f a0, a1, a2, a3;  // first halves of the four points after the transpose
+  Vec4f b0, b1, b2, b3;  // second halves
+};
+inline Rows rows_of(const Returns4& r, const Vec4f& time, const Vec4i& azimuth_ring, const Vec4i& type) {
+  Rows w{r.x, r.y, r.z, r.intensity, time, r.range, bits_as_float(azimuth_ring), bits_as_float(type)};
+  transpose4(w.a0, w.a1, w.a2, w.a3);
+  transpose4(w.b0, w.b1, w.b2, w.b3);
+  return w;
+}
 
 }  // namespace
 
-// The per-point arithmetic is the same as the straightforward per-return loop this replaces (and gives the same
-// floats: no reassociation, no fused multiply-add at -O2 without -march), except that azimuth cos/sin come from
-// the table (see azimuth_table()). Each firing group goes through loops over its 32 slots that the compiler
-// vectorises (azimuths, ranges, coordinates), one that looks the azimuths up in the table, and one that writes the
-// points out.
-template <bool kDual, bool kFastWrap>
-std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst,
-                                   AzimuthRange* azimuths) const {
-  constexpr std::size_t kStep = kDual ? 2 : 1;               // blocks per firing group
-  constexpr std::size_t kGroups = kBlocksPerPacket / kStep;  // firing groups per packet
-  constexpr std::size_t kSlots = kSlotsPerBlock;
+Expected<PacketHeader, DecodeError> Decoder::check(ByteSpan payload) const {
+  auto header = read_packet_header(payload);
+  if (!header) return header;
+  if (const auto e = accept(*header)) return Unexpected{*e};
+  return header;
+}
 
-  const float* const group_times = kDual ? group_time_s_[1].data() : group_time_s_[0].data();
+std::optional<DecodeError> Decoder::accept(const PacketHeader& header) const {
+  if (options_.model == Model::Unknown) return DecodeError::NoModel;
+  if (product_contradicts(options_.model, header.product_byte)) return DecodeError::ModelMismatch;
+  return std::nullopt;
+}
 
-  // Azimuth of each group and its step to the next group (the last group reuses the previous step).
+namespace {
+
+bool is_dual(const PacketHeader& header) { return header.return_mode == ReturnMode::Dual || header.dual_layout; }
+
+// Azimuth of each firing group and its step to the next group (the last group reuses the previous step).
+template <bool kDual>
+void read_group_azimuths(const std::uint8_t* bytes, std::array<float, kBlocksPerPacket>& az,
+                         std::array<float, kBlocksPerPacket>& delta) {
+  constexpr std::size_t kStep = kDual ? 2 : 1;
+  constexpr std::size_t kGroups = kBlocksPerPacket / kStep;
   std::array<int, kGroups> az_int{};
   for (std::size_t g = 0; g < kGroups; ++g) az_int[g] = load_le16_unchecked(bytes + g * kStep * kBlockSize + 2);
-  std::array<float, kGroups> az{};
-  std::array<float, kGroups> delta{};
   int fallback = 0;
   for (std::size_t g = 0; g < kGroups; ++g) {
     int d = fallback;
     if (g + 1 < kGroups) {
-      const int raw_step = (az_int[g + 1] - az_int[g] + kAzimuthUnits) % kAzimuthUnits;
+      // (next - this) mod 36000 for azimuths in [0, 36000) (read_packet_header() checked them), without a division.
+      int raw_step = az_int[g + 1] - az_int[g];
+      raw_step += kAzimuthUnits * static_cast<int>(raw_step < 0);
       if (raw_step <= kMaxGroupStepCdeg) d = raw_step;
     }
     fallback = d;
     az[g] = static_cast<float>(az_int[g]);
     delta[g] = static_cast<float>(d);
   }
-  if (azimuths != nullptr) {
-    *azimuths = AzimuthRange{};
-    if constexpr (kFastWrap) {
-      // Before wrapping, a firing's azimuth is az[g] + delta[g] * block_fraction - rot_cdeg with the fraction in
-      // [0, 1) and delta[g] >= 0: inside [az[g] - max_rot, az[g] + delta[g] - min_rot], give or take the float
-      // rounding (under 0.02 here). One unit of margin either side covers that and the rounding to 0.01 degree;
-      // a range inside [0, 35999] then holds every rounded azimuth, none of them wrapped.
-      float lo = az[0];
-      float hi = az[0] + delta[0];
-      for (std::size_t g = 1; g < kGroups; ++g) {
-        lo = std::min(lo, az[g]);
-        hi = std::max(hi, az[g] + delta[g]);
-      }
-      const float lo_cdeg = std::floor(lo - max_rot_cdeg_) - 1.F;
-      const float hi_cdeg = std::ceil(hi - min_rot_cdeg_) + 1.F;
-      if (lo_cdeg >= 0.F && hi_cdeg <= static_cast<float>(kAzimuthUnits - 1)) {
-        *azimuths = AzimuthRange{static_cast<std::uint16_t>(lo_cdeg), static_cast<std::uint16_t>(hi_cdeg)};
-      }
-    }
+}
+
+}  // namespace
+
+template <bool kDual>
+AzimuthRange Decoder::bounds_of(const GroupAzimuths& groups) const {
+  constexpr std::size_t kGroups = kBlocksPerPacket / (kDual ? 2 : 1);
+  if (!fast_wrap_) return AzimuthRange{};
+  // Before wrapping, a firing's azimuth is az[g] + delta[g] * block_fraction - rot_cdeg with the fraction in
+  // [0, 1) and delta[g] >= 0: inside [az[g] - max_rot, az[g] + delta[g] - min_rot], give or take the float
+  // rounding (under 0.02 here). One unit of margin either side covers that and the rounding to 0.01 degree;
+  // a range inside [0, 35999] then holds every rounded azimuth, none of them wrapped.
+  float lo = groups.az[0];
+  float hi = groups.az[0] + groups.delta[0];
+  for (std::size_t g = 1; g < kGroups; ++g) {
+    lo = std::min(lo, groups.az[g]);
+    hi = std::max(hi, groups.az[g] + groups.delta[g]);
   }
+  const float lo_cdeg = std::floor(lo - max_rot_cdeg_) - 1.F;
+  const float hi_cdeg = std::ceil(hi - min_rot_cdeg_) + 1.F;
+  if (lo_cdeg >= 0.F && hi_cdeg <= static_cast<float>(kAzimuthUnits - 1)) {
+    return AzimuthRange{static_cast<std::uint16_t>(lo_cdeg), static_cast<std::uint16_t>(hi_cdeg)};
+  }
+  return AzimuthRange{};
+}
 
-  const ReturnType single_type = header.return_mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
-  const float res = resolution_m_;
-  const auto min_r = static_cast<float>(options_.min_range_m);
-  const auto max_r = static_cast<float>(options_.max_range_m);
-  const AzimuthEntry* const table = azimuth_table().data();
+AzimuthRange Decoder::azimuth_bounds(ByteSpan payload, const PacketHeader& header) const {
+  if (payload.size() != kDataPacketSize) return AzimuthRange{};
+  GroupAzimuths groups;
+  if (is_dual(header)) {
+    read_group_azimuths<true>(payload.data(), groups.az, groups.delta);
+    return bounds_of<true>(groups);
+  }
+  read_group_azimuths<false>(payload.data(), groups.az, groups.delta);
+  return bounds_of<false>(groups);
+}
+
+namespace {
+
+// Where each of four points goes when only some are kept: for every mask of kept lanes (bit k: lane k), the byte
+// offset of lane k's point from the first free one (the number of kept lanes before it, times the point size) and
+// the number kept. A dropped lane gets the offset of the next kept one, which overwrites it (or of the first point
+// after them, which is free room): every lane is written, with no branch on the data.
+struct KeepTable {
+  std::array<std::array<std::uint8_t, 4>, 16> offset{};
+  std::array<std::uint8_t, 16> count{};
+};
+constexpr KeepTable kKeep = [] {
+  KeepTable k;
+  for (unsigned mask = 0; mask < 16; ++mask) {
+    unsigned kept = 0;
+    for (unsigned lane = 0; lane < 4; ++lane) {
+      k.offset[mask][lane] = static_cast<std::uint8_t>(kept * sizeof(LidarPoint));
+      kept += (mask >> lane) & 1U;
+    }
+    k.count[mask] = static_cast<std::uint8_t>(kept);
+  }
+  return k;
+}();
+
+// The lanes of `ok` (each 0 or all ones) as four bits.
+inline unsigned keep_mask(const Vec4i& ok) {
+#if defined(__SSE2__)
+  return static_cast<unsigned>(_mm_movemask_ps(bits_as_float(ok)));  // one instruction
+#else
+  return static_cast<unsigned>((ok[0] & 1) | (ok[1] & 2) | (ok[2] & 4) | (ok[3] & 8));
+#endif
+}
+
+// float(offset + double(t)) of each lane: RotationAssembler::commit()'s conversion of a packet-relative time to a
+// frame-relative one, two lanes at a time in double. SSE2's conversions where there is SSE2 (GCC lowers the
+// generic vector code for 2-lane halves through memory), the same conversions lane by lane elsewhere.
+using Vec2d = double __attribute__((vector_size(16)));
+inline Vec4f add_offset(const Vec4f& t, const Vec2d& offset) {
+#if defined(__SSE2__)
+  const __m128d lo = _mm_add_pd(_mm_cvtps_pd(t), offset);
+  const __m128d hi = _mm_add_pd(_mm_cvtps_pd(_mm_movehl_ps(t, t)), offset);
+  return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi));
+#else
+  return Vec4f{static_cast<float>(offset[0] + static_cast<double>(t[0])),
+               static_cast<float>(offset[0] + static_cast<double>(t[1])),
+               static_cast<float>(offset[0] + static_cast<double>(t[2])),
+               static_cast<float>(offset[0] + static_cast<double>(t[3]))};
+#endif
+}
+
+}  // namespace
+
+// One pass over each firing group, four slots at a time, everything in registers: azimuth and its table cos/sin,
+// the returns, the points, and their transposition into LidarPoints. The arithmetic of every point is the same
+// as the straightforward per-return loop's (and gives the same floats: no reassociation, no fused multiply-add
+// at -O2 without -march), except that azimuth cos/sin come from the table (see azimuth_table()).
+template <bool kDual, Decoder::Wrap kWrap>
+std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, const GroupAzimuths& groups,
+                                   const float* times, std::optional<double> time_offset_s, LidarPoint* dst) const {
+  constexpr std::size_t kStep = kDual ? 2 : 1;               // blocks per firing group
+  constexpr std::size_t kGroups = kBlocksPerPacket / kStep;  // firing groups per packet
+  constexpr std::size_t kSlots = kSlotsPerBlock;
+
   const SlotTables& t = slots_;
+  const Vec4f res = splat(resolution_m_);
+  const Vec4f min_r = splat(static_cast<float>(options_.min_range_m));
+  const Vec4f max_r = splat(static_cast<float>(options_.max_range_m));
+  const auto* const table = reinterpret_cast<const unsigned char*>(azimuth_table().data());
+  const ReturnType single_type = header.return_mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
+  const Vec4i type_single = splat_i(static_cast<std::int32_t>(return_type_word(single_type)));
+  const bool frame_times = time_offset_s.has_value();
+  const Vec2d offset = {time_offset_s.value_or(0.0), time_offset_s.value_or(0.0)};
 
-  // Azimuth of every firing of group g, its cos/sin and the firing time.
-  auto group_angles = [&](std::size_t g, GroupAngles& out) {
-    out.time_s = group_times + g * kSlots;
-    const float az_g = az[g];
-    const float delta_g = delta[g];
-    if constexpr (kFastWrap) {
-      alignas(16) std::array<std::int32_t, kSlots> index;
-      alignas(16) std::array<float, kSlots> frac;
-      for (std::size_t s = 0; s < kSlots; ++s) {
-        const float w = wrap_cdeg_fast(az_g + delta_g * t.block_fraction[s] - t.rot_cdeg[s]);
-        const auto i = static_cast<std::int32_t>(w);  // w >= 0: truncation is floor
-        const float f = w - static_cast<float>(i);     // exact
-        index[s] = i;
-        frac[s] = f;
-        out.azimuth_ring[s] = azimuth_word(round_cdeg32(i, f)) | t.ring_word[s];
-      }
-      // The table look-up, four slots at a time: four entries (cos, sin, dcos, dsin) transposed into a vector of
-      // each, then entry + fraction * step (the same float operations as one slot at a time).
-      for (std::size_t s = 0; s < kSlots; s += 4) {
-        Vec4f c = load4(&table[index[s]]);
-        Vec4f sn = load4(&table[index[s + 1]]);
-        Vec4f dc = load4(&table[index[s + 2]]);
-        Vec4f ds = load4(&table[index[s + 3]]);
-        transpose4(c, sn, dc, ds);
-        const Vec4f f = load4(&frac[s]);
-        const Vec4f cos4 = c + f * dc;
-        const Vec4f sin4 = sn + f * ds;
-        std::memcpy(&out.cos_a[s], &cos4, sizeof cos4);
-        std::memcpy(&out.sin_a[s], &sin4, sizeof sin4);
-      }
-    } else {
-      // Azimuth corrections of more than 350 degrees (or not finite): the general path, as it always was.
-      for (std::size_t s = 0; s < kSlots; ++s) {
-        const float w = wrap_cdeg(az_g + delta_g * t.block_fraction[s] - t.rot_cdeg[s]);
-        const float angle = w * (std::numbers::pi_v<float> / 18000.F);
-        out.cos_a[s] = std::cos(angle);
-        out.sin_a[s] = std::sin(angle);
-        out.azimuth_ring[s] = azimuth_ring_word(round_cdeg_lround(w), t.ring[s]);
-      }
+  // Four slots' angles, from the group's azimuth and step (splat).
+  auto angles4 = [&](const Vec4f& az_g, const Vec4f& delta_g, std::size_t s) {
+    Angles4 an;
+    constexpr auto kTurn = static_cast<float>(kAzimuthUnits);
+    Vec4f w = az_g + delta_g * load4(&t.block_fraction[s]) - load4(&t.rot_cdeg[s]);
+    if constexpr (kWrap == Wrap::Fast) {
+      // kernels::wrap_cdeg_fast() four lanes at a time (a comparison is -1 where true).
+      const Vec4i turns = (w < splat(0.F)) - (w >= splat(kTurn));
+      w = w - splat(kTurn) * __builtin_convertvector(turns, Vec4f);
     }
+    // Wrap::None: the packet's azimuth bounds (bounds_of()) lie inside [0, 35999], so every w is already in
+    // [0, 36000) and rounds to at most 35999: the wraps above and below would subtract 0.
+    const Vec4i i = __builtin_convertvector(w, Vec4i);  // w >= 0: truncation is floor
+    const Vec4f f = w - __builtin_convertvector(i, Vec4f);  // exact
+    // kernels::round_cdeg32() and azimuth_word().
+    Vec4i r = i - (f >= splat(0.5F));
+    if constexpr (kWrap == Wrap::Fast) r -= splat_i(kAzimuthUnits) & (r >= splat_i(kAzimuthUnits));
+    if constexpr (std::endian::native != std::endian::little) r <<= 16;
+    an.azimuth_ring = r | load4i(&t.ring_word[s]);
+    // The table look-up: four entries (cos, sin, dcos, dsin) transposed into a vector of each, then
+    // entry + fraction * step (the same float operations as one slot at a time). Byte offsets in unsigned lanes:
+    // no sign extension per lane.
+    const Vec4u at = __builtin_convertvector(i, Vec4u) * static_cast<std::uint32_t>(sizeof(AzimuthEntry));
+    Vec4f c = load4(table + at[0]);
+    Vec4f sn = load4(table + at[1]);
+    Vec4f dc = load4(table + at[2]);
+    Vec4f ds = load4(table + at[3]);
+    transpose4(c, sn, dc, ds);
+    an.cos_a = c + f * dc;
+    an.sin_a = sn + f * ds;
+    return an;
   };
 
-  // The returns of one block (kSlots of them at `b`) into points, all slots, in range or not.
-  auto block_points = [&](const std::uint8_t* b, const GroupAngles& ga, BlockPoints& out) {
-    // Four slots at a time: each slot's 3 bytes and the next one as a little-endian u32 (distance in the low 16
-    // bits, reflectivity in the next 8), split by masks. The last slot's 4th byte is the next block's flag, or
-    // the timestamp after the last block: inside the checked 1206 bytes.
-    for (std::size_t s = 0; s < kSlots; s += 4) {
-      const Vec4i v = {load_le32_unchecked(b + 3 * s), load_le32_unchecked(b + 3 * s + 3),
-                       load_le32_unchecked(b + 3 * s + 6), load_le32_unchecked(b + 3 * s + 9)};
-      const Vec4i raw = v & 0xFFFF;
-      const Vec4i intensity = (v >> 16) & 0xFF;
-      std::memcpy(&out.raw[s], &raw, sizeof raw);
-      std::memcpy(&out.intensity[s], &intensity, sizeof intensity);
-    }
+  // Four slots' returns of the block whose first slot is at `b` (after its flag and azimuth).
+  auto returns4 = [&](const std::uint8_t* b, std::size_t s, const Angles4& an) {
+    Returns4 r;
+    // Each slot's 3 bytes and the next one as a little-endian u32 (distance in the low 16 bits, reflectivity in
+    // the next 8), split by masks. The last slot's 4th byte is the next block's flag, or the timestamp after the
+    // last block: inside the checked 1206 bytes.
+    const Vec4i v = {load_le32_unchecked(b + 3 * s), load_le32_unchecked(b + 3 * s + 3),
+                     load_le32_unchecked(b + 3 * s + 6), load_le32_unchecked(b + 3 * s + 9)};
+    r.echo = v & 0xFFFFFF;  // only the dual path compares echoes (dead code elsewhere)
+    const Vec4i raw = v & 0xFFFF;
+    const Vec4f d = __builtin_convertvector(raw, Vec4f) * res + load4(&t.dist_m[s]);
+    r.ok = ((d >= min_r) & (d <= max_r)) & ~(raw == 0);
+    const Vec4f cos_vert = load4(&t.cos_vert[s]);
+    const Vec4f sin_vert = load4(&t.sin_vert[s]);
+    const Vec4f horiz = load4(&t.horiz_offset_m[s]);
+    const Vec4f xy = d * cos_vert - load4(&t.vert_offset_sin[s]);
+    r.range = d;
+    r.intensity = __builtin_convertvector((v >> 16) & 0xFF, Vec4f);
+    r.x = xy * an.cos_a + horiz * an.sin_a;
+    r.y = -xy * an.sin_a + horiz * an.cos_a;
+    r.z = d * sin_vert + load4(&t.vert_offset_cos[s]);
+    return r;
+  };
+
+  // Azimuth corrections of more than 350 degrees (or not finite): the general path, as it always was, a group's
+  // angles at a time into these arrays.
+  struct SlowAngles {
+    alignas(16) std::array<float, kSlots> cos_a;
+    alignas(16) std::array<float, kSlots> sin_a;
+    alignas(16) std::array<std::uint32_t, kSlots> azimuth_ring;
+  };
+  auto slow_angles = [&](float az_g, float delta_g, SlowAngles& out) {
     for (std::size_t s = 0; s < kSlots; ++s) {
-      const float d = static_cast<float>(out.raw[s]) * res + t.dist_m[s];
-      out.ok[s] = static_cast<std::int32_t>(out.raw[s] != 0) & static_cast<std::int32_t>(d >= min_r) &
-                  static_cast<std::int32_t>(d <= max_r);
-      const float xy = d * t.cos_vert[s] - t.vert_offset_m[s] * t.sin_vert[s];
-      out.range[s] = d;
-      out.intensity_f[s] = static_cast<float>(out.intensity[s]);
-      out.x[s] = xy * ga.cos_a[s] + t.horiz_offset_m[s] * ga.sin_a[s];
-      out.y[s] = -xy * ga.sin_a[s] + t.horiz_offset_m[s] * ga.cos_a[s];
-      out.z[s] = d * t.sin_vert[s] + t.vert_offset_m[s] * t.cos_vert[s];
+      const float w = wrap_cdeg(az_g + delta_g * t.block_fraction[s] - t.rot_cdeg[s]);
+      const float angle = w * (std::numbers::pi_v<float> / 18000.F);
+      out.cos_a[s] = std::cos(angle);
+      out.sin_a[s] = std::sin(angle);
+      out.azimuth_ring[s] = azimuth_ring_word(round_cdeg_lround(w), t.ring[s]);
     }
   };
 
-  // The points of four slots [s, s + 4) of block `bp` as the two 16-byte halves of each (put_point()), by two
-  // 4 x 4 transposes of the structure of arrays. `type` holds the four slots' return_type_word()s.
-  struct Four {
-    Vec4f a0, a1, a2, a3;  // first halves of the four points
-    Vec4f b0, b1, b2, b3;  // second halves
-  };
-  auto write4 = [&](const BlockPoints& bp, const GroupAngles& ga, std::size_t s, const Vec4f& type) {
-    Four f{load4(&bp.x[s]), load4(&bp.y[s]), load4(&bp.z[s]), load4(&bp.intensity_f[s]),
-           load4(ga.time_s + s), load4(&bp.range[s]), load4(&ga.azimuth_ring[s]), type};
-    transpose4(f.a0, f.a1, f.a2, f.a3);
-    transpose4(f.b0, f.b1, f.b2, f.b3);
-    return f;
-  };
-
+  // Every slot's point is written, in range or not, and kept (n advanced) only if in range: no branch on the data.
+  // The room holds kMaxPointsPerPacket points, and n never runs ahead of the slots written.
   std::size_t n = 0;
+  auto put = [&](const Vec4f& first, const Vec4f& second, std::int32_t keep) {
+    put_point(dst + n, first, second);
+    n += static_cast<std::size_t>(keep & 1);
+  };
   for (std::size_t g = 0; g < kGroups; ++g) {
     const std::uint8_t* const block0 = bytes + g * kStep * kBlockSize + 4;
-    GroupAngles ga;
-    group_angles(g, ga);
-    BlockPoints p0;
-    block_points(block0, ga, p0);
-    // Every slot's point is written, in range or not, and kept (n advanced) only if in range: no branch on the data.
-    // The room holds kMaxPointsPerPacket points, and n never runs ahead of the slots written.
-    if constexpr (!kDual) {
-      const auto w = std::bit_cast<float>(return_type_word(single_type));
-      const Vec4f type = {w, w, w, w};
-      // Written out four times rather than as a loop over k: the eight halves stay in registers.
-      for (std::size_t s = 0; s < kSlots; s += 4) {
-        const Four f = write4(p0, ga, s, type);
-        put_point(dst + n, f.a0, f.b0);
-        n += static_cast<std::size_t>(p0.ok[s]);
-        put_point(dst + n, f.a1, f.b1);
-        n += static_cast<std::size_t>(p0.ok[s + 1]);
-        put_point(dst + n, f.a2, f.b2);
-        n += static_cast<std::size_t>(p0.ok[s + 2]);
-        put_point(dst + n, f.a3, f.b3);
-        n += static_cast<std::size_t>(p0.ok[s + 3]);
+    const float* const time_g = times + g * kSlots;
+    const Vec4f az_g = splat(groups.az[g]);
+    const Vec4f delta_g = splat(groups.delta[g]);
+    [[maybe_unused]] SlowAngles slow;
+    if constexpr (kWrap == Wrap::General) slow_angles(groups.az[g], groups.delta[g], slow);
+    for (std::size_t s = 0; s < kSlots; s += 4) {
+      Angles4 an;
+      if constexpr (kWrap == Wrap::General) {
+        an = Angles4{load4(&slow.cos_a[s]), load4(&slow.sin_a[s]), load4i(&slow.azimuth_ring[s])};
+      } else {
+        an = angles4(az_g, delta_g, s);
       }
-    } else {
-      // Dual: the last return (block 0) and the strongest (block 1); one echo (both blocks equal) is emitted
-      // once, as StrongestAndLast.
-      BlockPoints p1;
-      block_points(block0 + kBlockSize, ga, p1);
-      alignas(16) std::array<std::uint32_t, kSlots> type0;
-      alignas(16) std::array<std::int32_t, kSlots> keep1;
-      for (std::size_t s = 0; s < kSlots; ++s) {
-        const bool same = p0.raw[s] == p1.raw[s] && p0.intensity[s] == p1.intensity[s];
-        type0[s] = return_type_word(same ? ReturnType::StrongestAndLast : ReturnType::Last);
-        keep1[s] = static_cast<std::int32_t>(p1.ok[s] != 0 && !same);
-      }
-      const auto w1 = std::bit_cast<float>(return_type_word(ReturnType::Strongest));
-      const Vec4f type1 = {w1, w1, w1, w1};
-      for (std::size_t s = 0; s < kSlots; s += 4) {
-        const Four f0 = write4(p0, ga, s, load4(&type0[s]));
-        const Four f1 = write4(p1, ga, s, type1);
-        put_point(dst + n, f0.a0, f0.b0);
-        n += static_cast<std::size_t>(p0.ok[s]);
-        put_point(dst + n, f1.a0, f1.b0);
-        n += static_cast<std::size_t>(keep1[s]);
-        put_point(dst + n, f0.a1, f0.b1);
-        n += static_cast<std::size_t>(p0.ok[s + 1]);
-        put_point(dst + n, f1.a1, f1.b1);
-        n += static_cast<std::size_t>(keep1[s + 1]);
-        put_point(dst + n, f0.a2, f0.b2);
-        n += static_cast<std::size_t>(p0.ok[s + 2]);
-        put_point(dst + n, f1.a2, f1.b2);
-        n += static_cast<std::size_t>(keep1[s + 2]);
-        put_point(dst + n, f0.a3, f0.b3);
-        n += static_cast<std::size_t>(p0.ok[s + 3]);
-        put_point(dst + n, f1.a3, f1.b3);
-        n += static_cast<std::size_t>(keep1[s + 3]);
+      Vec4f time = load4(time_g + s);
+      if (frame_times) time = add_offset(time, offset);
+      const Returns4 r0 = returns4(block0, s, an);
+      if constexpr (!kDual) {
+        const Rows w = rows_of(r0, time, an.azimuth_ring, type_single);
+        const unsigned mask = keep_mask(r0.ok);
+        const std::array<std::uint8_t, 4>& at = kKeep.offset[mask];
+        auto* const free = reinterpret_cast<unsigned char*>(dst + n);  // its object representation (put_point())
+        put_point_at(free + at[0], w.a0, w.b0);
+        put_point_at(free + at[1], w.a1, w.b1);
+        put_point_at(free + at[2], w.a2, w.b2);
+        put_point_at(free + at[3], w.a3, w.b3);
+        n += kKeep.count[mask];
+      } else {
+        // Dual: the last return (block 0) and the strongest (block 1), slot by slot; one echo (both blocks
+        // equal) is emitted once, as StrongestAndLast.
+        const Returns4 r1 = returns4(block0 + kBlockSize, s, an);
+        const Vec4i same = r0.echo == r1.echo;
+        const Vec4i type0 =
+            (same & static_cast<std::int32_t>(return_type_word(ReturnType::StrongestAndLast))) |
+            (~same & static_cast<std::int32_t>(return_type_word(ReturnType::Last)));
+        const Vec4i keep1 = r1.ok & ~same;
+        const Rows w0 = rows_of(r0, time, an.azimuth_ring, type0);
+        const Rows w1 =
+            rows_of(r1, time, an.azimuth_ring, splat_i(static_cast<std::int32_t>(return_type_word(ReturnType::Strongest))));
+        put(w0.a0, w0.b0, r0.ok[0]);
+        put(w1.a0, w1.b0, keep1[0]);
+        put(w0.a1, w0.b1, r0.ok[1]);
+        put(w1.a1, w1.b1, keep1[1]);
+        put(w0.a2, w0.b2, r0.ok[2]);
+        put(w1.a2, w1.b2, keep1[2]);
+        put(w0.a3, w0.b3, r0.ok[3]);
+        put(w1.a3, w1.b3, keep1[3]);
       }
     }
   }
   return n;
 }
 
-Expected<PacketHeader, DecodeError> Decoder::check(ByteSpan payload) const {
-  auto header = read_packet_header(payload);
-  if (!header) return header;
-  if (options_.model == Model::Unknown) return Unexpected{DecodeError::NoModel};
-  if (product_contradicts(options_.model, header->product_byte)) return Unexpected{DecodeError::ModelMismatch};
-  return header;
-}
-
 std::size_t Decoder::decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room,
-                                   AzimuthRange* azimuths) const {
-  const bool dual = header.return_mode == ReturnMode::Dual || header.dual_layout;
+                                    AzimuthRange* azimuths, std::optional<double> time_offset_s) const {
+  const bool dual = is_dual(header);
   const std::uint8_t* const bytes = payload.data();  // length checked by read_packet_header()
+  GroupAzimuths groups;
   if (dual) {
-    return fast_wrap_ ? decode_points<true, true>(bytes, header, room, azimuths)
-                      : decode_points<true, false>(bytes, header, room, azimuths);
+    read_group_azimuths<true>(bytes, groups.az, groups.delta);
+  } else {
+    read_group_azimuths<false>(bytes, groups.az, groups.delta);
   }
-  return fast_wrap_ ? decode_points<false, true>(bytes, header, room, azimuths)
-                    : decode_points<false, false>(bytes, header, room, azimuths);
+  const AzimuthRange bounds = dual ? bounds_of<true>(groups) : bounds_of<false>(groups);
+  if (azimuths != nullptr) *azimuths = bounds;
+  // Bounds inside the turn (bounds_of() gives them only on the fast path) leave nothing to wrap.
+  const bool inside = bounds.max_cdeg < kAzimuthUnits;
+  const float* const times = dual ? group_time_s_[1].data() : group_time_s_[0].data();
+  if (dual) {
+    if (!fast_wrap_) return decode_points<true, Wrap::General>(bytes, header, groups, times, time_offset_s, room);
+    return inside ? decode_points<true, Wrap::None>(bytes, header, groups, times, time_offset_s, room)
+                  : decode_points<true, Wrap::Fast>(bytes, header, groups, times, time_offset_s, room);
+  }
+  if (!fast_wrap_) return decode_points<false, Wrap::General>(bytes, header, groups, times, time_offset_s, room);
+  return inside ? decode_points<false, Wrap::None>(bytes, header, groups, times, time_offset_s, room)
+                : decode_points<false, Wrap::Fast>(bytes, header, groups, times, time_offset_s, room);
 }
 
 Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vector<LidarPoint>& out) const {
@@ -429,7 +535,7 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vecto
   // packet after packet to one vector does not reallocate per packet.
   const std::size_t base = out.size();
   out.resize(base + kMaxPointsPerPacket);
-  out.resize(base + decode_checked(payload, *header, out.data() + base, nullptr));
+  out.resize(base + decode_checked(payload, *header, out.data() + base, nullptr, std::nullopt));
   return header;
 }
 
@@ -438,7 +544,7 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<
   count = 0;
   auto header = check(payload);
   if (!header) return header;
-  count = decode_checked(payload, *header, room.data(), nullptr);
+  count = decode_checked(payload, *header, room.data(), nullptr, std::nullopt);
   return header;
 }
 
@@ -448,8 +554,15 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<
   azimuths = AzimuthRange{};
   auto header = check(payload);
   if (!header) return header;
-  count = decode_checked(payload, *header, room.data(), &azimuths);
+  count = decode_checked(payload, *header, room.data(), &azimuths, std::nullopt);
   return header;
+}
+
+std::size_t Decoder::decode_accepted(ByteSpan payload, const PacketHeader& header,
+                                     std::span<LidarPoint, kMaxPointsPerPacket> room,
+                                     std::optional<double> time_offset_s) const {
+  if (payload.size() != kDataPacketSize || accept(header)) return 0;  // misuse: nothing decoded
+  return decode_checked(payload, header, room.data(), nullptr, time_offset_s);
 }
 
 }  // namespace fieldguard::velodyne

@@ -36,23 +36,35 @@ void Stream::count_frames(const std::vector<LidarFrame>& done, std::size_t from)
   }
 }
 
-void Stream::decode_one(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done) {
+void Stream::decode_one(ByteSpan payload, const PacketHeader& header, Stamp host_time, std::vector<LidarFrame>& done) {
+  if (const auto error = decoder_->accept(header)) {
+    ++counters_.errors[static_cast<std::size_t>(*error)];
+    return;
+  }
+  const Stamp sensor = sensor_time_from_hour_offset(header.timestamp_us, host_time);
+  const AzimuthRange azimuths = decoder_->azimuth_bounds(payload, header);
   // Decoded straight into the frame under construction: no copy of the points, no initialisation of their room.
   const std::span<LidarPoint> room = assembler_.append_room(Decoder::kMaxPointsPerPacket);
+  const std::span<LidarPoint, Decoder::kMaxPointsPerPacket> fixed(room.data(), room.size());
   std::size_t count = 0;
-  AzimuthRange azimuths;
-  const auto header = decoder_->decode(
-      payload, std::span<LidarPoint, Decoder::kMaxPointsPerPacket>(room.data(), room.size()), count, azimuths);
-  if (!header) {
-    ++counters_.errors[static_cast<std::size_t>(header.error())];
-    return;
+  const std::size_t before = done.size();
+  if (const auto offset_s = assembler_.in_frame_offset_s(azimuths, sensor)) {
+    // Nearly every packet: inside the frame under way, so the decoder writes the frame-relative times itself and
+    // the assembler need not go over the points again.
+    count = decoder_->decode_accepted(payload, header, fixed, offset_s);
+    assembler_.commit_in_frame(count);
+  } else {
+    count = decoder_->decode_accepted(payload, header, fixed, std::nullopt);
+    assembler_.commit(count, sensor, host_time, done, azimuths);
   }
   ++counters_.decoded;
   counters_.points += count;
-  const Stamp sensor = sensor_time_from_hour_offset(header->timestamp_us, host_time);
-  const std::size_t before = done.size();
-  assembler_.commit(count, sensor, host_time, done, azimuths);
   count_frames(done, before);
+}
+
+void Stream::decode_held(const Held& held, std::vector<LidarFrame>& done) {
+  // Held packets passed read_packet_header() when they came in.
+  if (const auto header = read_packet_header(held.bytes)) decode_one(held.bytes, *header, held.host, done);
 }
 
 void Stream::push(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done) {
@@ -82,10 +94,10 @@ void Stream::push(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& do
     start_decoder(*m);
     auto held = std::move(held_);
     held_.clear();
-    for (const auto& h : held) decode_one(h.bytes, h.host, done);
+    for (const auto& h : held) decode_held(h, done);
     return;
   }
-  decode_one(payload, host_time, done);
+  decode_one(payload, *header, host_time, done);
 }
 
 void Stream::finish(std::vector<LidarFrame>& done) {
@@ -97,7 +109,7 @@ void Stream::finish(std::vector<LidarFrame>& done) {
     if (header && header->product_byte == 0x21) m = Model::HDL32E;
     if (m) {
       start_decoder(*m);
-      for (const auto& h : held_) decode_one(h.bytes, h.host, done);
+      for (const auto& h : held_) decode_held(h, done);
     } else {
       counters_.errors[static_cast<std::size_t>(DecodeError::NoModel)] += held_.size();
     }

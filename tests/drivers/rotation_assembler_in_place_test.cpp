@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -221,6 +222,74 @@ TEST(RotationAssemblerInPlace, AzimuthBoundsGiveTheReferenceFrames) {
     if (HasFatalFailure()) return;
   }
   EXPECT_GT(fast_packets, 40U * 400U / 2);
+}
+
+// A decoder that makes the times frame-relative itself (velodyne::Stream): where in_frame_offset_s() gives an
+// offset, the points are written with float(offset + double(time)) and commit_in_frame()ted; elsewhere as before.
+// The same frames as the reference, bit for bit; and the offset is refused before any frame, and where the bounds
+// hold the cut or are no information.
+TEST(RotationAssemblerInPlace, FrameRelativeTimesFromTheDecoderGiveTheReferenceFrames) {
+  std::mt19937 rng(23);
+  auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  std::size_t in_frame = 0;
+  std::size_t empty_in_frame = 0;
+  for (int run = 0; run < 40; ++run) {
+    const double cut = run % 4 == 0 ? 0.0 : uniform(0, 35999) / 100.0;
+    reference::RotationAssembler ref(cut);
+    RotationAssembler fast(cut);
+    std::vector<LidarFrame> want;
+    std::vector<LidarFrame> got;
+    EXPECT_FALSE(fast.in_frame_offset_s(AzimuthRange{100, 200}, Stamp{0}).has_value()) << "no frame under way";
+    int az = uniform(0, 35999);
+    std::int64_t t = 1'000'000'000'000;
+    for (int packet = 0; packet < 400; ++packet) {
+      std::vector<LidarPoint> pts(static_cast<std::size_t>(uniform(0, 40)));
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const int kind = uniform(0, 99);
+        az += kind < 90 ? uniform(0, 60) : kind < 95 ? -uniform(0, 1200) : uniform(0, 36000);
+        az = ((az % 36000) + 36000) % 36000;
+        pts[i].azimuth_cdeg = static_cast<std::uint16_t>(az);
+        pts[i].time_s = static_cast<float>(i) * 1.152e-6F - 5e-4F;
+        pts[i].y = static_cast<float>(packet);
+      }
+      AzimuthRange bounds;
+      if (!pts.empty() && uniform(0, 9) != 0) {
+        int lo = 65535;
+        int hi = 0;
+        for (const auto& p : pts) {
+          lo = std::min<int>(lo, p.azimuth_cdeg);
+          hi = std::max<int>(hi, p.azimuth_cdeg);
+        }
+        bounds = AzimuthRange{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
+      }
+      t += uniform(0, 2'000'000);
+      ref.push(pts, Stamp{t}, Stamp{t + 700}, want);
+      const std::optional<double> offset = fast.in_frame_offset_s(bounds, Stamp{t});
+      if (bounds.max_cdeg >= 36000) {
+        EXPECT_FALSE(offset.has_value());
+      }
+      const std::span<LidarPoint> room = fast.append_room(pts.size());
+      std::copy(pts.begin(), pts.end(), room.begin());
+      if (offset) {
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+          room[i].time_s = static_cast<float>(*offset + static_cast<double>(pts[i].time_s));
+        }
+        fast.commit_in_frame(pts.size());
+        ++(pts.empty() ? empty_in_frame : in_frame);
+      } else {
+        fast.commit(pts.size(), Stamp{t}, Stamp{t + 700}, got, bounds);
+      }
+      if (packet == 200) {
+        ref.finish(want);
+        fast.finish(got);
+      }
+    }
+    ref.finish(want);
+    fast.finish(got);
+    expect_same_frames(got, want, "run " + std::to_string(run));
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(in_frame, 40U * 400U / 2);
 }
 
 // Bounds that are no information (the default, or min > max) are safe: the per-point path.

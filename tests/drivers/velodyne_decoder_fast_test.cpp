@@ -9,6 +9,7 @@
 #include <cstring>
 #include <iostream>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -116,6 +117,28 @@ void compare_packets(const std::vector<std::vector<std::uint8_t>>& packets, cons
     if (bounds.min_cdeg > 0 || bounds.max_cdeg < 0xFFFF) {
       ++diff.bounded;
       EXPECT_LT(bounds.max_cdeg, 36000) << what << " packet " << k;
+    }
+    // velodyne::Stream's steps: the same bounds from the azimuths alone, the same points from decode_accepted(),
+    // and with a time offset the times RotationAssembler::commit() would make of them, nothing else changed.
+    const AzimuthRange early = fast.azimuth_bounds(packets[k], *h);
+    EXPECT_EQ(early.min_cdeg, bounds.min_cdeg) << what << " packet " << k;
+    EXPECT_EQ(early.max_cdeg, bounds.max_cdeg) << what << " packet " << k;
+    const std::span<LidarPoint, Decoder::kMaxPointsPerPacket> fixed(room);
+    std::memset(static_cast<void*>(room.data()), 0x5A, room.size() * sizeof(LidarPoint));
+    ASSERT_EQ(fast.decode_accepted(packets[k], *h, fixed, std::nullopt), a.size()) << what << " packet " << k;
+    ASSERT_EQ(std::memcmp(static_cast<const void*>(room.data()), static_cast<const void*>(a.data()),
+                          a.size() * sizeof(LidarPoint)),
+              0)
+        << what << " packet " << k << ": decode_accepted() differs";
+    for (const double offset : {0.1234567891, -0.0421, 0.0}) {
+      std::memset(static_cast<void*>(room.data()), 0x77, room.size() * sizeof(LidarPoint));
+      ASSERT_EQ(fast.decode_accepted(packets[k], *h, fixed, offset), a.size()) << what << " packet " << k;
+      std::vector<LidarPoint> shifted = a;
+      for (auto& p : shifted) p.time_s = static_cast<float>(offset + static_cast<double>(p.time_s));
+      ASSERT_EQ(std::memcmp(static_cast<const void*>(room.data()), static_cast<const void*>(shifted.data()),
+                            a.size() * sizeof(LidarPoint)),
+                0)
+          << what << " packet " << k << ": decode_accepted() with time offset " << offset << " differs";
     }
     ref.decode(packets[k], *h, b);
     expect_same_points(a, b, diff, what + " packet " + std::to_string(k));
@@ -269,6 +292,35 @@ TEST(VelodyneDecoderFast, RandomPacketsMatchTheReferenceDecoder) {
 
 // The azimuth table's own error: every whole and many fractional azimuths at 130 m, against cos/sin in double of
 // the very float azimuth the decoder computes (replicated here), so that only the table's error is measured.
+// decode_accepted() is for packets read_packet_header() and accept() passed: anything else decodes to nothing.
+TEST(VelodyneDecoderFast, DecodeAcceptedRefusesWhatDecodeRefuses) {
+  const auto packets = capture("hdl32e_monterey_600.pcap");
+  ASSERT_FALSE(packets.empty());
+  const auto header = read_packet_header(packets.front());
+  ASSERT_TRUE(header.has_value());
+  std::vector<LidarPoint> room(Decoder::kMaxPointsPerPacket);
+  const std::span<LidarPoint, Decoder::kMaxPointsPerPacket> fixed(room);
+  DecoderOptions o;
+  o.model = Model::HDL32E;
+  const Decoder hdl(default_calibration(Model::HDL32E), o);
+  EXPECT_FALSE(hdl.accept(*header).has_value());
+  EXPECT_GT(hdl.decode_accepted(packets.front(), *header, fixed, std::nullopt), 0U);
+  // Too short a payload for the header it is given.
+  const std::vector<std::uint8_t> cut(packets.front().begin(), packets.front().begin() + 600);
+  EXPECT_EQ(hdl.decode_accepted(cut, *header, fixed, 0.5), 0U);
+  EXPECT_EQ(hdl.azimuth_bounds(cut, *header).max_cdeg, 0xFFFF);
+  // A product byte of another sensor: ModelMismatch, as decode() says.
+  PacketHeader other = *header;
+  other.product_byte = 0x28;
+  EXPECT_EQ(hdl.accept(other), DecodeError::ModelMismatch);
+  EXPECT_EQ(hdl.decode_accepted(packets.front(), other, fixed, std::nullopt), 0U);
+  // No model: NoModel.
+  o.model = Model::Unknown;
+  const Decoder none(default_calibration(Model::HDL32E), o);
+  EXPECT_EQ(none.accept(*header), DecodeError::NoModel);
+  EXPECT_EQ(none.decode_accepted(packets.front(), *header, fixed, std::nullopt), 0U);
+}
+
 TEST(VelodyneDecoderFast, AzimuthTableErrorAt130m) {
   DecoderOptions o;
   o.model = Model::HDL32E;

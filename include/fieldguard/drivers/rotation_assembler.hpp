@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -43,6 +44,17 @@ class RotationAssembler {
   // every point's azimuth lies inside the bounds; AzimuthRange{} (every azimuth) is always safe.
   void commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time, std::vector<LidarFrame>& done,
               AzimuthRange azimuths);
+
+  // For a decoder that makes the point times frame-relative itself (velodyne::Decoder::decode_accepted()): where a
+  // packet with these azimuth bounds can neither end the frame under way nor step back across the cut (the
+  // conditions of commit() with bounds, above), the offset in seconds from the packet's sensor time to the frame's,
+  // which commit() would add to every packet-relative time (as float(offset + double(time_s))); nullopt where the
+  // bounds do not show that (then decode packet-relative times and commit() as usual).
+  [[nodiscard]] std::optional<double> in_frame_offset_s(AzimuthRange azimuths, Stamp packet_sensor_time) const;
+  // Commits the first `count` points of append_room(), written with frame-relative times after in_frame_offset_s()
+  // gave an offset (and nothing else changed the assembler in between). Gives exactly what commit() with bounds
+  // gives for the same points with packet-relative times.
+  void commit_in_frame(std::size_t count);
 
   // End of stream: emits what is pending as a partial frame (if it holds any point).
   void finish(std::vector<LidarFrame>& done);

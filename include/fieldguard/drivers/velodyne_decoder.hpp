@@ -67,15 +67,39 @@ class Decoder {
   Expected<PacketHeader, DecodeError> decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
                                              std::size_t& count, AzimuthRange& azimuths) const;
 
+  // The steps of decode(), for velodyne::Stream, which has read the header (read_packet_header()) already and wants
+  // the point times frame-relative straight from the decoder (RotationAssembler::in_frame_offset_s()):
+  //  - accept(): the model checks decode() makes on top of read_packet_header() (NoModel, ModelMismatch);
+  //  - azimuth_bounds(): the bounds decode() gives, from the block azimuths alone (before decoding the points);
+  //  - decode_accepted(): the points of a packet accept() accepted, as decode() writes them, except that with a
+  //    time_offset_s every time_s is float(time_offset_s + double(the packet-relative time)): exactly what
+  //    RotationAssembler::commit() makes of it.
+  [[nodiscard]] std::optional<DecodeError> accept(const PacketHeader& header) const;
+  [[nodiscard]] AzimuthRange azimuth_bounds(ByteSpan payload, const PacketHeader& header) const;
+  [[nodiscard]] std::size_t decode_accepted(ByteSpan payload, const PacketHeader& header,
+                                            std::span<LidarPoint, kMaxPointsPerPacket> room,
+                                            std::optional<double> time_offset_s) const;
+
   [[nodiscard]] Model model() const { return options_.model; }
 
  private:
+  // Azimuth of each firing group of a packet and its step to the next group (single return: 12 groups, dual: 6).
+  struct GroupAzimuths {
+    std::array<float, kBlocksPerPacket> az{};
+    std::array<float, kBlocksPerPacket> delta{};
+  };
   [[nodiscard]] Expected<PacketHeader, DecodeError> check(ByteSpan payload) const;
   [[nodiscard]] std::size_t decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room,
-                                           AzimuthRange* azimuths) const;
-  template <bool kDual, bool kFastWrap>
-  [[nodiscard]] std::size_t decode_points(const std::uint8_t* bytes, const PacketHeader& header, LidarPoint* dst,
-                                          AzimuthRange* azimuths) const;
+                                           AzimuthRange* azimuths, std::optional<double> time_offset_s) const;
+  template <bool kDual>
+  [[nodiscard]] AzimuthRange bounds_of(const GroupAzimuths& groups) const;
+  // How a firing's azimuth is brought into [0, 36000): not at all (the packet's azimuth bounds lie inside the turn),
+  // by one add or subtract of a turn (fast_wrap_), or by fmod and libm cos/sin (corrections beyond 350 degrees).
+  enum class Wrap : std::uint8_t { None, Fast, General };
+  template <bool kDual, Wrap kWrap>
+  [[nodiscard]] std::size_t decode_points(const std::uint8_t* bytes, const PacketHeader& header,
+                                          const GroupAzimuths& groups, const float* times,
+                                          std::optional<double> time_offset_s, LidarPoint* dst) const;
 
   DecoderOptions options_;
   Calibration calibration_;
@@ -93,6 +117,10 @@ class Decoder {
     std::array<float, kSlotsPerBlock> block_fraction;  // in_block_us / block duration: share of the azimuth step
     std::array<std::uint16_t, kSlotsPerBlock> ring;
     std::array<std::uint32_t, kSlotsPerBlock> ring_word;  // the ring's half of a point's (azimuth, ring) word
+    // vert_offset_m * sin_vert and vert_offset_m * cos_vert: products the per-point formulas take, rounded to float
+    // here exactly as they would be there (one float multiply), so that a point costs two multiplies fewer.
+    std::array<float, kSlotsPerBlock> vert_offset_sin;
+    std::array<float, kSlotsPerBlock> vert_offset_cos;
   };
   SlotTables slots_{};
   // Time of each firing of a packet (s), relative to the firing the packet timestamp marks: [0] single return

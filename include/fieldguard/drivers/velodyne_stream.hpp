@@ -60,7 +60,9 @@ class Stream {
     Stamp host;
   };
   void start_decoder(Model m);
-  void decode_one(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& done);
+  // A packet read_packet_header() accepted (`header`), once the decoder exists.
+  void decode_one(ByteSpan payload, const PacketHeader& header, Stamp host_time, std::vector<LidarFrame>& done);
+  void decode_held(const Held& held, std::vector<LidarFrame>& done);
   void count_frames(const std::vector<LidarFrame>& done, std::size_t from);
 
   StreamOptions options_;
