@@ -43,6 +43,17 @@ struct Decoded {
   std::vector<Stamp> host;
 };
 
+// The tight azimuth bounds of a packet's points, as a decoder reports them (non-empty `pts`).
+AzimuthRange azimuth_bounds_of(const std::vector<LidarPoint>& pts) {
+  int lo = 65535;
+  int hi = 0;
+  for (const auto& p : pts) {
+    lo = std::min<int>(lo, p.azimuth_cdeg);
+    hi = std::max<int>(hi, p.azimuth_cdeg);
+  }
+  return AzimuthRange{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
+}
+
 Decoded decode_capture(const char* file, Model model, const Calibration& cal) {
   DecoderOptions o;
   o.model = model;
@@ -193,17 +204,11 @@ TEST(RotationAssemblerInPlace, AzimuthBoundsGiveTheReferenceFrames) {
       }
       AzimuthRange bounds;
       if (!pts.empty() && uniform(0, 9) != 0) {
-        int lo = 65535;
-        int hi = 0;
-        for (const auto& p : pts) {
-          lo = std::min<int>(lo, p.azimuth_cdeg);
-          hi = std::max<int>(hi, p.azimuth_cdeg);
-        }
+        bounds = azimuth_bounds_of(pts);
         if (uniform(0, 1) == 0) {  // loose
-          lo = std::max(0, lo - uniform(0, 3000));
-          hi = std::min(65535, hi + uniform(0, 3000));
+          bounds.min_cdeg = static_cast<std::uint16_t>(std::max(0, bounds.min_cdeg - uniform(0, 3000)));
+          bounds.max_cdeg = static_cast<std::uint16_t>(std::min(65535, bounds.max_cdeg + uniform(0, 3000)));
         }
-        bounds = AzimuthRange{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
       }
       t += uniform(0, 2'000'000);
       ref.push(pts, Stamp{t}, Stamp{t + 700}, want);
@@ -253,15 +258,7 @@ TEST(RotationAssemblerInPlace, FrameRelativeTimesFromTheDecoderGiveTheReferenceF
         pts[i].y = static_cast<float>(packet);
       }
       AzimuthRange bounds;
-      if (!pts.empty() && uniform(0, 9) != 0) {
-        int lo = 65535;
-        int hi = 0;
-        for (const auto& p : pts) {
-          lo = std::min<int>(lo, p.azimuth_cdeg);
-          hi = std::max<int>(hi, p.azimuth_cdeg);
-        }
-        bounds = AzimuthRange{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi)};
-      }
+      if (!pts.empty() && uniform(0, 9) != 0) bounds = azimuth_bounds_of(pts);
       t += uniform(0, 2'000'000);
       ref.push(pts, Stamp{t}, Stamp{t + 700}, want);
       const std::optional<double> offset = fast.in_frame_offset_s(bounds, Stamp{t});
