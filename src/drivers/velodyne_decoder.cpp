@@ -375,7 +375,9 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
     constexpr auto kTurn = static_cast<float>(kAzimuthUnits);
     Vec4f w = az_g + delta_g * load4(&t.block_fraction[s]) - load4(&t.rot_cdeg[s]);
     if constexpr (kWrap == Wrap::Fast) {
-      // kernels::wrap_cdeg_fast() four lanes at a time (a comparison is -1 where true).
+      // wrap_cdeg() for w in (-36000, 72000), four lanes at a time: fmod's result there is w, w - 36000 (exact by
+      // Sterbenz' lemma for w <= 72000) or w + 36000 (w < 0). Written as w - 36000 * {-1, 0, 1}, which gives the
+      // same floats without a select (a comparison is -1 where true).
       const Vec4i turns = (w < splat(0.F)) - (w >= splat(kTurn));
       w = w - splat(kTurn) * __builtin_convertvector(turns, Vec4f);
     }
@@ -383,7 +385,7 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
     // [0, 36000) and rounds to at most 35999: the wraps above and below would subtract 0.
     const Vec4i i = __builtin_convertvector(w, Vec4i);  // w >= 0: truncation is floor
     const Vec4f f = w - __builtin_convertvector(i, Vec4f);  // exact
-    // kernels::round_cdeg32() and azimuth_word().
+    // kernels::round_cdeg() in 32-bit lanes, then the azimuth's half of azimuth_ring_word().
     Vec4i r = i - (f >= splat(0.5F));
     if constexpr (kWrap == Wrap::Fast) r -= splat_i(kAzimuthUnits) & (r >= splat_i(kAzimuthUnits));
     if constexpr (std::endian::native != std::endian::little) r <<= 16;

@@ -24,16 +24,6 @@ inline float wrap_cdeg(float a) {
   return a;
 }
 
-// The same result as wrap_cdeg() for a in (-36000, 72000): fmod's result there is a, a - 36000 (exact by Sterbenz'
-// lemma for a <= 72000) or a (a < 0, then + 36000 as above). Written as a - 36000 * {-1, 0, 1}, which gives the
-// same floats (a - 0 = a, a - (-36000) = a + 36000) without a branch or a select: the compiler may neither
-// speculate a conditional floating-point operation (-ftrapping-math) nor, at -O2, vectorise a float select.
-inline float wrap_cdeg_fast(float a) {
-  constexpr auto kTurn = static_cast<float>(kTurnCdeg);
-  const std::int32_t turns = static_cast<std::int32_t>(a >= kTurn) - static_cast<std::int32_t>(a < 0.F);
-  return a - kTurn * static_cast<float>(turns);
-}
-
 inline std::uint16_t round_cdeg_lround(float wrapped) {
   const long r = std::lround(wrapped);
   return static_cast<std::uint16_t>(r >= kTurnCdeg ? r - kTurnCdeg : r);
@@ -44,12 +34,6 @@ inline std::uint16_t round_cdeg_lround(float wrapped) {
 inline std::uint16_t round_cdeg(std::int32_t i, float f) {
   const std::int32_t r = i + static_cast<std::int32_t>(f >= 0.5F);
   return static_cast<std::uint16_t>(r - kTurnCdeg * static_cast<std::int32_t>(r >= kTurnCdeg));
-}
-// round_cdeg() kept in 32 bits (the value is 0..35999 either way): a loop over slots of 32-bit lanes only, which
-// the compiler vectorises where the narrowing to 16 bits would keep it scalar.
-inline std::int32_t round_cdeg32(std::int32_t i, float f) {
-  const std::int32_t r = i + static_cast<std::int32_t>(f >= 0.5F);
-  return r - kTurnCdeg * static_cast<std::int32_t>(r >= kTurnCdeg);
 }
 
 // cos and sin of every whole 0.01 degree, with the step to the next entry, for linear interpolation: 36001 entries
@@ -140,13 +124,9 @@ constexpr std::uint32_t azimuth_ring_word(std::uint16_t azimuth_cdeg, std::uint1
   if constexpr (std::endian::native == std::endian::little) return azimuth_cdeg | (std::uint32_t{ring} << 16);
   return (std::uint32_t{azimuth_cdeg} << 16) | ring;
 }
-// azimuth_ring_word(a, r) == (azimuth_word(a) | ring_word(r)) for every a, r: the two halves apart, so that the ring's
-// half is made once per slot and the azimuth's per firing in 32-bit lanes.
-constexpr std::uint32_t azimuth_word(std::int32_t azimuth_cdeg) {  // azimuth_cdeg in 0..65535
-  const auto a = static_cast<std::uint32_t>(azimuth_cdeg);
-  if constexpr (std::endian::native == std::endian::little) return a;
-  return a << 16;
-}
+// azimuth_ring_word(a, r) == (a's word | ring_word(r)) for every a, r, a's word being a on little-endian and a << 16
+// on big-endian: the two halves apart, so that the ring's half is made once per slot and the azimuth's per firing
+// in 32-bit lanes (VelodyneDecoder's angles4).
 constexpr std::uint32_t ring_word(std::uint16_t ring) {
   if constexpr (std::endian::native == std::endian::little) return std::uint32_t{ring} << 16;
   return ring;
