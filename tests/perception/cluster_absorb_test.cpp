@@ -113,11 +113,8 @@ TEST(ClusterAbsorber, PartialClusteringAndBadInput) {
 // grown by the margin, holds its box. The absorber tests four big boxes at a time; its choice must be this one,
 // with more big clusters than one group of four, boxes inside boxes and boxes sharing an edge.
 TEST(ClusterAbsorber, TakesTheFirstHoldingBoxAsOneAtATime) {
-  std::uint64_t seed = 3;
-  const auto next = [&seed] {
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
-  };
+  testing::TestRng rng(3);
+  const auto next = [&rng] { return rng.uniform(0.F, 1.F); };
   for (int trial = 0; trial < 40; ++trial) {
     Cloud c;
     Sets sets;

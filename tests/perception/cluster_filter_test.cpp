@@ -174,11 +174,8 @@ TEST(ClusterFilter, GuessedGroundLimitsTheHeightToTheClustersOwnExtent) {
 // The pipeline rejects a cluster with fewer than least_min_points points without summarizing it: no summary may
 // let such a cluster through, under any of the rules that lower the count (distance, floating), on or off.
 TEST(ClusterFilter, NoClusterBelowTheLeastMinimumPasses) {
-  std::uint64_t seed = 5;
-  const auto next = [&seed] {
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
-  };
+  testing::TestRng rng(5);
+  const auto next = [&rng] { return rng.uniform(0.F, 1.F); };
   for (int variant = 0; variant < 16; ++variant) {
     FilterParams f;
     f.min_points = 6 + variant % 3;

@@ -320,11 +320,8 @@ TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
   p.sectors = {16, 32, 48, 64};
   const ZoneGround zones(p);
   Cloud c;
-  std::uint64_t seed = 7;
-  const auto next = [&seed] {  // a small LCG: the same points on every machine
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
-  };
+  testing::TestRng rng(7);  // the same points on every machine
+  const auto next = [&rng] { return rng.uniform(0.F, 1.F); };
   for (int i = 0; i < 20000; ++i) {
     const float r = 60.F * next() * next(), a = static_cast<float>(2.0 * kPi) * next();
     c.push_back(r * std::cos(a), r * std::sin(a), 0.F);
@@ -356,11 +353,8 @@ TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
 
 // The ground's distances go through hypot_f: it must give std::hypot's bits, or heights (and obstacles) change.
 TEST(ZoneGround, HypotGivesTheLibrarysBits) {
-  std::uint64_t seed = 11;
-  const auto bits = [&seed] {
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<std::uint32_t>(seed >> 32);
-  };
+  testing::TestRng rng(11);
+  const auto bits = [&rng] { return static_cast<std::uint32_t>(rng.next() >> 32U); };
   const auto from_bits = [](std::uint32_t u) {
     float f = 0.F;
     std::memcpy(&f, &u, sizeof f);
