@@ -154,6 +154,7 @@ int main(int argc, char** argv) {
   const Clock::time_point start = Clock::now();
   std::uint64_t sent = 0;
   std::uint64_t sent_data = 0;
+  std::int64_t last_sent_us = 0;
   for (long l = 0; l < loops && g_stop == 0; ++l) {
     for (Datagram& d : datagrams) {
       if (g_stop != 0) break;
@@ -171,14 +172,22 @@ int main(int argc, char** argv) {
         ::close(fd);
         return 1;
       }
+      // When the receiver last heard from us, on the clock its logs use: a test of a silence timeout measures
+      // from here, not from when it saw this process exit (late by a scheduling delay on a loaded machine).
+      last_sent_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
       ++sent;
       if (d.payload.size() == kDataPacketSize) ++sent_data;
     }
   }
   ::close(fd);
   const double took = std::chrono::duration<double>(Clock::now() - start).count();
-  std::fprintf(stderr, "fieldguard-udp-player: sent %llu datagrams (%llu data packets) in %.3f s (%llu skipped by --map)%s\n",
+  std::fprintf(stderr,
+               "fieldguard-udp-player: sent %llu datagrams (%llu data packets) in %.3f s (%llu skipped by --map)%s, "
+               "the last at %lld us UTC\n",
                static_cast<unsigned long long>(sent), static_cast<unsigned long long>(sent_data), took,
-               static_cast<unsigned long long>(skipped), g_stop != 0 ? ", stopped by a signal" : "");
+               static_cast<unsigned long long>(skipped), g_stop != 0 ? ", stopped by a signal" : "",
+               static_cast<long long>(last_sent_us));
   return 0;
 }
