@@ -58,6 +58,7 @@
 #include "fieldguard/perception/ransac_ground.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
 #include "fieldguard/perception/zone_ground.hpp"
+#include "sim/rng.hpp"
 #include "sim_frames.hpp"
 
 namespace {
@@ -531,11 +532,8 @@ void BM_ClusterJoinScattered(benchmark::State& state) {
   const auto count = static_cast<std::size_t>(state.range(0));
   Cloud c;
   std::vector<float> height;
-  std::uint64_t seed = 12345;
-  const auto next = [&seed] {  // a small LCG: the same cloud on every machine
-    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<float>(seed >> 40) / static_cast<float>(1ULL << 24);
-  };
+  sim::Rng rng(12345);  // the simulator's generator: the same cloud on every machine
+  const auto next = [&rng] { return static_cast<float>(rng.uniform()); };
   for (std::size_t i = 0; i < count; ++i) {
     const float h = 3.F * next();
     c.push_back(50.F * next(), 20.F * next() - 10.F, h - 0.95F);
