@@ -28,7 +28,6 @@ using kernels::azimuth_table;
 using kernels::load4;
 using kernels::load_le16_unchecked;
 using kernels::load_le32_unchecked;
-using kernels::put_point;
 using kernels::put_point_at;
 using kernels::round_cdeg_lround;
 using kernels::return_type_word;
@@ -83,12 +82,21 @@ bool product_contradicts(Model m, std::uint8_t product) {
 
 Expected<PacketHeader, DecodeError> read_packet_header(ByteSpan payload) {
   if (payload.size() != kDataPacketSize) return Unexpected{DecodeError::BadLength};
+  // Every block at once, without a branch per block (the length is checked); only a packet that fails looks again,
+  // block by block, for the first error.
   std::array<std::uint16_t, kBlocksPerPacket> azimuth{};
+  unsigned bad = 0;
   for (std::size_t b = 0; b < kBlocksPerPacket; ++b) {
-    const std::size_t base = b * kBlockSize;
-    if (load_le16(payload, base) != kBlockFlag) return Unexpected{DecodeError::BadBlockFlag};
-    azimuth[b] = load_le16(payload, base + 2);
-    if (azimuth[b] >= kAzimuthUnits) return Unexpected{DecodeError::BadAzimuth};
+    const std::uint8_t* const block = payload.data() + b * kBlockSize;
+    azimuth[b] = load_le16_unchecked(block + 2);
+    bad |= static_cast<unsigned>(load_le16_unchecked(block) != kBlockFlag) |
+           static_cast<unsigned>(azimuth[b] >= kAzimuthUnits);
+  }
+  if (bad != 0) {
+    for (std::size_t b = 0; b < kBlocksPerPacket; ++b) {
+      if (load_le16(payload, b * kBlockSize) != kBlockFlag) return Unexpected{DecodeError::BadBlockFlag};
+      if (azimuth[b] >= kAzimuthUnits) return Unexpected{DecodeError::BadAzimuth};
+    }
   }
   PacketHeader h;
   h.timestamp_us = load_le32(payload, kTimestampOffset);
@@ -112,6 +120,49 @@ Expected<PacketHeader, DecodeError> read_packet_header(ByteSpan payload) {
   }
   return h;
 }
+
+namespace {
+
+inline Vec4f splat(float v) { return Vec4f{v, v, v, v}; }
+inline Vec4i splat_i(std::int32_t v) { return Vec4i{v, v, v, v}; }
+inline Vec4i load4i(const void* p) {
+  Vec4i v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+using Vec4u = std::uint32_t __attribute__((vector_size(16)));
+inline Vec4f bits_as_float(const Vec4i& v) {
+  Vec4f f;
+  std::memcpy(&f, &v, sizeof f);
+  return f;
+}
+
+// The range of four returns from their raw distances: the one formula of the per-slot loop and of the integer
+// range test worked out from it (Decoder::SlotTables::raw_above), so that both round alike.
+inline Vec4f range_of(const Vec4i& raw, const Vec4f& resolution, const Vec4f& dist) {
+  return __builtin_convertvector(raw, Vec4f) * resolution + dist;
+}
+
+constexpr std::int32_t kMaxRaw = 0xFFFF;
+
+// The smallest raw distance in [1, kMaxRaw] for which `rises` holds, kMaxRaw + 1 if none; `rises` must be false up
+// to some raw and true from there on.
+template <typename Pred>
+std::int32_t first_raw_where(Pred rises) {
+  std::int32_t lo = 1;
+  std::int32_t hi = kMaxRaw + 1;
+  while (lo < hi) {
+    const std::int32_t mid = lo + (hi - lo) / 2;
+    if (rises(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+}  // namespace
 
 Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
     : options_(options), calibration_(calibration) {
@@ -162,6 +213,20 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
   }
   min_rot_cdeg_ = *std::min_element(slots_.rot_cdeg.begin(), slots_.rot_cdeg.end());
   max_rot_cdeg_ = *std::max_element(slots_.rot_cdeg.begin(), slots_.rot_cdeg.end());
+  // The kept raw distances of each slot, from the float test itself: range_of() does not fall as raw rises (float
+  // conversion, multiply by a positive resolution and add are monotonic), so `range >= min` turns true once and
+  // `range <= max` false once, also for a non-finite dist_m or limit (never true, or true throughout).
+  const Vec4f res = splat(resolution_m_);
+  const auto min_r = static_cast<float>(options_.min_range_m);
+  const auto max_r = static_cast<float>(options_.max_range_m);
+  for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {
+    const Vec4f dist = splat(slots_.dist_m[slot]);
+    const auto range = [&](std::int32_t raw) { return range_of(splat_i(raw), res, dist)[0]; };
+    const std::int32_t first_near = first_raw_where([&](std::int32_t raw) { return range(raw) >= min_r; });
+    const std::int32_t first_far = first_raw_where([&](std::int32_t raw) { return !(range(raw) <= max_r); });
+    slots_.raw_above[slot] = first_near - 1;  // >= 0: raw 0 ("no return") is never kept
+    slots_.raw_below[slot] = first_far;
+  }
   // Point times relative to the firing the packet timestamp marks, per firing group and slot.
   for (std::size_t dual = 0; dual < 2; ++dual) {
     const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring
@@ -179,20 +244,6 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
 
 namespace {
 
-inline Vec4f splat(float v) { return Vec4f{v, v, v, v}; }
-inline Vec4i splat_i(std::int32_t v) { return Vec4i{v, v, v, v}; }
-inline Vec4i load4i(const void* p) {
-  Vec4i v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-using Vec4u = std::uint32_t __attribute__((vector_size(16)));
-inline Vec4f bits_as_float(const Vec4i& v) {
-  Vec4f f;
-  std::memcpy(&f, &v, sizeof f);
-  return f;
-}
-
 // The angles of four slots of a firing group: azimuth cos/sin and the (azimuth, ring) words of the points.
 struct Angles4 {
   Vec4f cos_a;
@@ -207,7 +258,7 @@ struct Returns4 {
   Vec4i echo;  // distance and reflectivity bytes as they came: two blocks carry the same echo where these are equal
 };
 
-// Four points as LidarPoints: the two 16-byte halves of each (kernels::put_point()), by two 4 x 4 transposes of
+// Four points as LidarPoints: the two 16-byte halves of each (kernels::put_point_at()), by two 4 x 4 transposes of
 // the rows (x, y, z, intensity) and (time, range, (azimuth, ring) word, return_type_word()).
 struct Rows {
   Vec4f a0, a1, a2, a3;  // first halves of the four points after the transpose
@@ -239,73 +290,102 @@ namespace {
 
 bool is_dual(const PacketHeader& header) { return header.return_mode == ReturnMode::Dual || header.dual_layout; }
 
-// Azimuth of each firing group and its step to the next group (the last group reuses the previous step).
-template <bool kDual>
-void read_group_azimuths(const std::uint8_t* bytes, std::array<float, kBlocksPerPacket>& az,
-                         std::array<float, kBlocksPerPacket>& delta) {
-  constexpr std::size_t kStep = kDual ? 2 : 1;
-  constexpr std::size_t kGroups = kBlocksPerPacket / kStep;
-  std::array<int, kGroups> az_int{};
-  for (std::size_t g = 0; g < kGroups; ++g) az_int[g] = load_le16_unchecked(bytes + g * kStep * kBlockSize + 2);
-  int fallback = 0;
-  for (std::size_t g = 0; g < kGroups; ++g) {
-    int d = fallback;
-    if (g + 1 < kGroups) {
-      // (next - this) mod 36000 for azimuths in [0, 36000) (read_packet_header() checked them), without a division.
-      int raw_step = az_int[g + 1] - az_int[g];
-      raw_step += kAzimuthUnits * static_cast<int>(raw_step < 0);
-      if (raw_step <= kMaxGroupStepCdeg) d = raw_step;
-    }
-    fallback = d;
-    az[g] = static_cast<float>(az_int[g]);
-    delta[g] = static_cast<float>(d);
-  }
+// The lanes of `ok` (each 0 or all ones) as four bits.
+inline unsigned keep_mask(const Vec4i& ok) {
+#if defined(__SSE2__)
+  return static_cast<unsigned>(_mm_movemask_ps(bits_as_float(ok)));  // one instruction
+#else
+  return static_cast<unsigned>((ok[0] & 1) | (ok[1] & 2) | (ok[2] & 4) | (ok[3] & 8));
+#endif
 }
 
 }  // namespace
 
+// Azimuth of each firing group and its step to the next group (the last group reuses the previous step), and the
+// bounds they give.
 template <bool kDual>
-AzimuthRange Decoder::bounds_of(const GroupAzimuths& groups) const {
-  constexpr std::size_t kGroups = kBlocksPerPacket / (kDual ? 2 : 1);
-  if (!fast_wrap_) return AzimuthRange{};
+Decoder::PacketAzimuths Decoder::read_azimuths(const std::uint8_t* bytes) const {
+  constexpr std::size_t kStep = kDual ? 2 : 1;
+  constexpr std::size_t kGroups = kBlocksPerPacket / kStep;
+  PacketAzimuths out;
+  out.dual_ = kDual;
+  out.min_rot_bits_ = std::bit_cast<std::uint32_t>(min_rot_cdeg_);
+  out.max_rot_bits_ = std::bit_cast<std::uint32_t>(max_rot_cdeg_);
+  // Four groups at a time: kChunks vectors of azimuths, the lanes past the last group holding copies of it (and of
+  // its step), which change neither the minimum nor the maximum below.
+  constexpr std::size_t kChunks = (kGroups + 3) / 4;
+  constexpr std::size_t kLanes = 4 * kChunks;
+  alignas(16) std::array<std::int32_t, kLanes + 1> az_int{};
+  for (std::size_t g = 0; g < kGroups; ++g) az_int[g] = load_le16_unchecked(bytes + g * kStep * kBlockSize + 2);
+  for (std::size_t g = kGroups; g <= kLanes; ++g) az_int[g] = az_int[kGroups - 1];
+  // Each group's step to the next: (next - this) mod 36000 for azimuths in [0, 36000) (checked below), without a
+  // division; a step beyond kMaxGroupStepCdeg is a corrupted azimuth, replaced by the step before it.
+  alignas(16) std::array<std::int32_t, kLanes> step{};
+  unsigned too_far = 0;
+  unsigned out_of_turn = 0;
+  for (std::size_t c = 0; c < kLanes; c += 4) {
+    const Vec4i here = load4i(&az_int[c]);
+    Vec4i d = load4i(&az_int[c + 1]) - here;
+    d += splat_i(kAzimuthUnits) & (d < splat_i(0));
+    too_far |= keep_mask(d > splat_i(kMaxGroupStepCdeg));
+    out_of_turn |= keep_mask(here >= splat_i(kAzimuthUnits));
+    std::memcpy(&step[c], &d, sizeof d);
+  }
+  if (too_far != 0) {  // rare: the sequential rule, group by group
+    std::int32_t fallback = 0;
+    for (std::size_t g = 0; g + 1 < kGroups; ++g) {
+      if (step[g] > kMaxGroupStepCdeg) step[g] = fallback;
+      fallback = step[g];
+    }
+  }
+  for (std::size_t g = kGroups - 1; g < kLanes; ++g) step[g] = step[kGroups - 2];  // the last group: the step before
+  // Floats (exact below 2^24) for the per-slot loop, and from them the smallest azimuth and the largest azimuth plus
+  // step, as the bounds below need them.
+  Vec4f lo4 = splat(static_cast<float>(az_int[0]));
+  Vec4f hi4 = splat(0.F);
+  alignas(16) std::array<float, kLanes> az_f{};
+  alignas(16) std::array<float, kLanes> step_f{};
+  for (std::size_t c = 0; c < kLanes; c += 4) {
+    const Vec4f az = __builtin_convertvector(load4i(&az_int[c]), Vec4f);
+    const Vec4f d = __builtin_convertvector(load4i(&step[c]), Vec4f);
+    lo4 = az < lo4 ? az : lo4;
+    hi4 = az + d > hi4 ? az + d : hi4;
+    std::memcpy(&az_f[c], &az, sizeof az);
+    std::memcpy(&step_f[c], &d, sizeof d);
+  }
+  std::memcpy(out.az_.data(), az_f.data(), kGroups * sizeof(float));
+  std::memcpy(out.delta_.data(), step_f.data(), kGroups * sizeof(float));
+  const float lo = std::min(std::min(lo4[0], lo4[1]), std::min(lo4[2], lo4[3]));
+  const float hi = std::max(std::max(hi4[0], hi4[1]), std::max(hi4[2], hi4[3]));
+  const bool bad = out_of_turn != 0;  // read_packet_header() refuses these; a caller of azimuths() may not have
+  out.valid_ = !bad;
+  if (bad || !fast_wrap_) return out;
   // Before wrapping, a firing's azimuth is az[g] + delta[g] * block_fraction - rot_cdeg with the fraction in
   // [0, 1) and delta[g] >= 0: inside [az[g] - max_rot, az[g] + delta[g] - min_rot], give or take the float
   // rounding (under 0.02 here). One unit of margin either side covers that and the rounding to 0.01 degree;
   // a range inside [0, 35999] then holds every rounded azimuth, none of them wrapped.
-  float lo = groups.az[0];
-  float hi = groups.az[0] + groups.delta[0];
-  for (std::size_t g = 1; g < kGroups; ++g) {
-    lo = std::min(lo, groups.az[g]);
-    hi = std::max(hi, groups.az[g] + groups.delta[g]);
-  }
   const float lo_cdeg = std::floor(lo - max_rot_cdeg_) - 1.F;
   const float hi_cdeg = std::ceil(hi - min_rot_cdeg_) + 1.F;
   if (lo_cdeg >= 0.F && hi_cdeg <= static_cast<float>(kAzimuthUnits - 1)) {
-    return AzimuthRange{static_cast<std::uint16_t>(lo_cdeg), static_cast<std::uint16_t>(hi_cdeg)};
+    out.bounds_ = AzimuthRange{static_cast<std::uint16_t>(lo_cdeg), static_cast<std::uint16_t>(hi_cdeg)};
   }
-  return AzimuthRange{};
+  return out;
 }
 
-AzimuthRange Decoder::azimuth_bounds(ByteSpan payload, const PacketHeader& header) const {
-  if (payload.size() != kDataPacketSize) return AzimuthRange{};
-  GroupAzimuths groups;
-  if (is_dual(header)) {
-    read_group_azimuths<true>(payload.data(), groups.az, groups.delta);
-    return bounds_of<true>(groups);
-  }
-  read_group_azimuths<false>(payload.data(), groups.az, groups.delta);
-  return bounds_of<false>(groups);
+Decoder::PacketAzimuths Decoder::azimuths(ByteSpan payload, const PacketHeader& header) const {
+  if (payload.size() != kDataPacketSize) return PacketAzimuths{};  // not valid: decodes to nothing
+  return is_dual(header) ? read_azimuths<true>(payload.data()) : read_azimuths<false>(payload.data());
 }
 
 namespace {
 
 // Where each of four points goes when only some are kept: for every mask of kept lanes (bit k: lane k), the byte
 // offset of lane k's point from the first free one (the number of kept lanes before it, times the point size) and
-// the number kept. A dropped lane gets the offset of the next kept one, which overwrites it (or of the first point
-// after them, which is free room): every lane is written, with no branch on the data.
+// the bytes the kept points take. A dropped lane gets the offset of the next kept one, which overwrites it (or of
+// the first point after them, which is free room): every lane is written, with no branch on the data.
 struct KeepTable {
   std::array<std::array<std::uint8_t, 4>, 16> offset{};
-  std::array<std::uint8_t, 16> count{};
+  std::array<std::uint8_t, 16> bytes{};  // kept lanes times the point size
 };
 constexpr KeepTable kKeep = [] {
   KeepTable k;
@@ -315,19 +395,10 @@ constexpr KeepTable kKeep = [] {
       k.offset[mask][lane] = static_cast<std::uint8_t>(kept * sizeof(LidarPoint));
       kept += (mask >> lane) & 1U;
     }
-    k.count[mask] = static_cast<std::uint8_t>(kept);
+    k.bytes[mask] = static_cast<std::uint8_t>(kept * sizeof(LidarPoint));
   }
   return k;
 }();
-
-// The lanes of `ok` (each 0 or all ones) as four bits.
-inline unsigned keep_mask(const Vec4i& ok) {
-#if defined(__SSE2__)
-  return static_cast<unsigned>(_mm_movemask_ps(bits_as_float(ok)));  // one instruction
-#else
-  return static_cast<unsigned>((ok[0] & 1) | (ok[1] & 2) | (ok[2] & 4) | (ok[3] & 8));
-#endif
-}
 
 // float(offset + double(t)) of each lane: RotationAssembler::commit()'s conversion of a packet-relative time to a
 // frame-relative one, two lanes at a time in double. SSE2's conversions where there is SSE2 (GCC lowers the
@@ -352,22 +423,19 @@ inline Vec4f add_offset(const Vec4f& t, const Vec2d& offset) {
 // the returns, the points, and their transposition into LidarPoints. The arithmetic of every point is the same
 // as the straightforward per-return loop's (and gives the same floats: no reassociation, no fused multiply-add
 // at -O2 without -march), except that azimuth cos/sin come from the table (see azimuth_table()).
-template <bool kDual, Decoder::Wrap kWrap>
-std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, const GroupAzimuths& groups,
-                                   const float* times, std::optional<double> time_offset_s, LidarPoint* dst) const {
+template <bool kDual, Decoder::Wrap kWrap, bool kFrameTimes>
+std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader& header, const PacketAzimuths& groups,
+                                   const float* times, double time_offset_s, LidarPoint* dst) const {
   constexpr std::size_t kStep = kDual ? 2 : 1;               // blocks per firing group
   constexpr std::size_t kGroups = kBlocksPerPacket / kStep;  // firing groups per packet
   constexpr std::size_t kSlots = kSlotsPerBlock;
 
   const SlotTables& t = slots_;
   const Vec4f res = splat(resolution_m_);
-  const Vec4f min_r = splat(static_cast<float>(options_.min_range_m));
-  const Vec4f max_r = splat(static_cast<float>(options_.max_range_m));
   const auto* const table = reinterpret_cast<const unsigned char*>(azimuth_table().data());
   const ReturnType single_type = header.return_mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
   const Vec4i type_single = splat_i(static_cast<std::int32_t>(return_type_word(single_type)));
-  const bool frame_times = time_offset_s.has_value();
-  const Vec2d offset = {time_offset_s.value_or(0.0), time_offset_s.value_or(0.0)};
+  const Vec2d offset = {time_offset_s, time_offset_s};
 
   // Four slots' angles, from the group's azimuth and step (splat).
   auto angles4 = [&](const Vec4f& az_g, const Vec4f& delta_g, std::size_t s) {
@@ -414,8 +482,9 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
                      load_le32_unchecked(b + 3 * s + 6), load_le32_unchecked(b + 3 * s + 9)};
     r.echo = v & 0xFFFFFF;  // only the dual path compares echoes (dead code elsewhere)
     const Vec4i raw = v & 0xFFFF;
-    const Vec4f d = __builtin_convertvector(raw, Vec4f) * res + load4(&t.dist_m[s]);
-    r.ok = ((d >= min_r) & (d <= max_r)) & ~(raw == 0);
+    const Vec4f d = range_of(raw, res, load4(&t.dist_m[s]));
+    // min_range_m <= d <= max_range_m and raw != 0, in integers (SlotTables::raw_above).
+    r.ok = (raw > load4i(&t.raw_above[s])) & (raw < load4i(&t.raw_below[s]));
     const Vec4f cos_vert = load4(&t.cos_vert[s]);
     const Vec4f sin_vert = load4(&t.sin_vert[s]);
     const Vec4f horiz = load4(&t.horiz_offset_m[s]);
@@ -445,20 +514,22 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
     }
   };
 
-  // Every slot's point is written, in range or not, and kept (n advanced) only if in range: no branch on the data.
-  // The room holds kMaxPointsPerPacket points, and n never runs ahead of the slots written.
-  std::size_t n = 0;
+  // Every slot's point is written, in range or not, and kept (`out` advanced) only if in range: no branch on the
+  // data. The room holds kMaxPointsPerPacket points, and `out` never runs ahead of the slots written. A byte
+  // pointer into the room's object representation (put_point_at()), so that a kept point costs one add.
+  auto* const first_free = reinterpret_cast<unsigned char*>(dst);
+  unsigned char* out = first_free;
   auto put = [&](const Vec4f& first, const Vec4f& second, std::int32_t keep) {
-    put_point(dst + n, first, second);
-    n += static_cast<std::size_t>(keep & 1);
+    put_point_at(out, first, second);
+    out += sizeof(LidarPoint) * static_cast<std::size_t>(keep & 1);
   };
   for (std::size_t g = 0; g < kGroups; ++g) {
     const std::uint8_t* const block0 = bytes + g * kStep * kBlockSize + 4;
     const float* const time_g = times + g * kSlots;
-    const Vec4f az_g = splat(groups.az[g]);
-    const Vec4f delta_g = splat(groups.delta[g]);
+    const Vec4f az_g = splat(groups.az_[g]);
+    const Vec4f delta_g = splat(groups.delta_[g]);
     [[maybe_unused]] SlowAngles slow;
-    if constexpr (kWrap == Wrap::General) slow_angles(groups.az[g], groups.delta[g], slow);
+    if constexpr (kWrap == Wrap::General) slow_angles(groups.az_[g], groups.delta_[g], slow);
     for (std::size_t s = 0; s < kSlots; s += 4) {
       Angles4 an;
       if constexpr (kWrap == Wrap::General) {
@@ -467,18 +538,17 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
         an = angles4(az_g, delta_g, s);
       }
       Vec4f time = load4(time_g + s);
-      if (frame_times) time = add_offset(time, offset);
+      if constexpr (kFrameTimes) time = add_offset(time, offset);
       const Returns4 r0 = returns4(block0, s, an);
       if constexpr (!kDual) {
         const Rows w = rows_of(r0, time, an.azimuth_ring, type_single);
         const unsigned mask = keep_mask(r0.ok);
         const std::array<std::uint8_t, 4>& at = kKeep.offset[mask];
-        auto* const free = reinterpret_cast<unsigned char*>(dst + n);  // its object representation (put_point())
-        put_point_at(free + at[0], w.a0, w.b0);
-        put_point_at(free + at[1], w.a1, w.b1);
-        put_point_at(free + at[2], w.a2, w.b2);
-        put_point_at(free + at[3], w.a3, w.b3);
-        n += kKeep.count[mask];
+        put_point_at(out + at[0], w.a0, w.b0);
+        put_point_at(out + at[1], w.a1, w.b1);
+        put_point_at(out + at[2], w.a2, w.b2);
+        put_point_at(out + at[3], w.a3, w.b3);
+        out += kKeep.bytes[mask];
       } else {
         // Dual: the last return (block 0) and the strongest (block 1), slot by slot; one echo (both blocks
         // equal) is emitted once, as StrongestAndLast.
@@ -502,32 +572,28 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
       }
     }
   }
-  return n;
+  return static_cast<std::size_t>(out - first_free) / sizeof(LidarPoint);
 }
 
-std::size_t Decoder::decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room,
-                                    AzimuthRange* azimuths, std::optional<double> time_offset_s) const {
-  const bool dual = is_dual(header);
-  const std::uint8_t* const bytes = payload.data();  // length checked by read_packet_header()
-  GroupAzimuths groups;
-  if (dual) {
-    read_group_azimuths<true>(bytes, groups.az, groups.delta);
-  } else {
-    read_group_azimuths<false>(bytes, groups.az, groups.delta);
+std::size_t Decoder::decode_checked(const std::uint8_t* bytes, const PacketHeader& header,
+                                    const PacketAzimuths& groups, LidarPoint* room,
+                                    std::optional<double> time_offset_s) const {
+  const float* const times = groups.dual_ ? group_time_s_[1].data() : group_time_s_[0].data();
+  const auto run = [&]<bool kDual, Wrap kWrap>() {
+    if (time_offset_s) return decode_points<kDual, kWrap, true>(bytes, header, groups, times, *time_offset_s, room);
+    return decode_points<kDual, kWrap, false>(bytes, header, groups, times, 0.0, room);
+  };
+  // Bounds inside the turn (read_azimuths() gives them only on the fast path) leave nothing to wrap; trusted only
+  // where they were worked out with this decoder's azimuth corrections.
+  const bool inside = groups.bounds_.max_cdeg < kAzimuthUnits &&
+                      groups.min_rot_bits_ == std::bit_cast<std::uint32_t>(min_rot_cdeg_) &&
+                      groups.max_rot_bits_ == std::bit_cast<std::uint32_t>(max_rot_cdeg_);
+  if (groups.dual_) {
+    if (!fast_wrap_) return run.template operator()<true, Wrap::General>();
+    return inside ? run.template operator()<true, Wrap::None>() : run.template operator()<true, Wrap::Fast>();
   }
-  const AzimuthRange bounds = dual ? bounds_of<true>(groups) : bounds_of<false>(groups);
-  if (azimuths != nullptr) *azimuths = bounds;
-  // Bounds inside the turn (bounds_of() gives them only on the fast path) leave nothing to wrap.
-  const bool inside = bounds.max_cdeg < kAzimuthUnits;
-  const float* const times = dual ? group_time_s_[1].data() : group_time_s_[0].data();
-  if (dual) {
-    if (!fast_wrap_) return decode_points<true, Wrap::General>(bytes, header, groups, times, time_offset_s, room);
-    return inside ? decode_points<true, Wrap::None>(bytes, header, groups, times, time_offset_s, room)
-                  : decode_points<true, Wrap::Fast>(bytes, header, groups, times, time_offset_s, room);
-  }
-  if (!fast_wrap_) return decode_points<false, Wrap::General>(bytes, header, groups, times, time_offset_s, room);
-  return inside ? decode_points<false, Wrap::None>(bytes, header, groups, times, time_offset_s, room)
-                : decode_points<false, Wrap::Fast>(bytes, header, groups, times, time_offset_s, room);
+  if (!fast_wrap_) return run.template operator()<false, Wrap::General>();
+  return inside ? run.template operator()<false, Wrap::None>() : run.template operator()<false, Wrap::Fast>();
 }
 
 Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vector<LidarPoint>& out) const {
@@ -537,7 +603,8 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vecto
   // packet after packet to one vector does not reallocate per packet.
   const std::size_t base = out.size();
   out.resize(base + kMaxPointsPerPacket);
-  out.resize(base + decode_checked(payload, *header, out.data() + base, nullptr, std::nullopt));
+  out.resize(base + decode_checked(payload.data(), *header, azimuths(payload, *header), out.data() + base,
+                                   std::nullopt));
   return header;
 }
 
@@ -546,25 +613,30 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<
   count = 0;
   auto header = check(payload);
   if (!header) return header;
-  count = decode_checked(payload, *header, room.data(), nullptr, std::nullopt);
+  count = decode_checked(payload.data(), *header, azimuths(payload, *header), room.data(), std::nullopt);
   return header;
 }
 
 Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
-                                                    std::size_t& count, AzimuthRange& azimuths) const {
+                                                    std::size_t& count, AzimuthRange& azimuths_out) const {
   count = 0;
-  azimuths = AzimuthRange{};
+  azimuths_out = AzimuthRange{};
   auto header = check(payload);
   if (!header) return header;
-  count = decode_checked(payload, *header, room.data(), &azimuths, std::nullopt);
+  const PacketAzimuths az = azimuths(payload, *header);
+  azimuths_out = az.bounds_;
+  count = decode_checked(payload.data(), *header, az, room.data(), std::nullopt);
   return header;
 }
 
-std::size_t Decoder::decode_accepted(ByteSpan payload, const PacketHeader& header,
+std::size_t Decoder::decode_accepted(ByteSpan payload, const PacketHeader& header, const PacketAzimuths& groups,
                                      std::span<LidarPoint, kMaxPointsPerPacket> room,
                                      std::optional<double> time_offset_s) const {
-  if (payload.size() != kDataPacketSize || accept(header)) return 0;  // misuse: nothing decoded
-  return decode_checked(payload, header, room.data(), nullptr, time_offset_s);
+  // Misuse (another payload's or layout's azimuths, a payload read_packet_header() would refuse): nothing decoded.
+  if (payload.size() != kDataPacketSize || !groups.valid_ || groups.dual_ != is_dual(header) || accept(header)) {
+    return 0;
+  }
+  return decode_checked(payload.data(), header, groups, room.data(), time_offset_s);
 }
 
 }  // namespace fieldguard::velodyne

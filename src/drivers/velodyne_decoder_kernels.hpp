@@ -137,14 +137,9 @@ constexpr std::uint32_t return_type_word(ReturnType type) {  // source = reserve
   return t << 24;
 }
 
-// The same at `bytes`, the object representation of a LidarPoint (of the room a decoder writes to).
+// A point's two halves written at `bytes`: the object representation of a LidarPoint of the room a decoder writes
+// to (trivially copyable, so its bytes may be written directly).
 inline void put_point_at(unsigned char* bytes, const Vec4f& first, const Vec4f& second) {
-  std::memcpy(bytes, &first, sizeof first);
-  std::memcpy(bytes + sizeof first, &second, sizeof second);
-}
-
-inline void put_point(LidarPoint* dst, const Vec4f& first, const Vec4f& second) {
-  auto* const bytes = reinterpret_cast<unsigned char*>(dst);  // its object representation: trivially copyable
   std::memcpy(bytes, &first, sizeof first);
   std::memcpy(bytes + sizeof first, &second, sizeof second);
 }

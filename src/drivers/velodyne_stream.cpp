@@ -42,20 +42,21 @@ void Stream::decode_one(ByteSpan payload, const PacketHeader& header, Stamp host
     return;
   }
   const Stamp sensor = sensor_time_from_hour_offset(header.timestamp_us, host_time);
-  const AzimuthRange azimuths = decoder_->azimuth_bounds(payload, header);
+  // The group azimuths, read once: their bounds for the assembler, the azimuths themselves for the decoder.
+  const Decoder::PacketAzimuths azimuths = decoder_->azimuths(payload, header);
   // Decoded straight into the frame under construction: no copy of the points, no initialisation of their room.
   const std::span<LidarPoint> room = assembler_.append_room(Decoder::kMaxPointsPerPacket);
   const std::span<LidarPoint, Decoder::kMaxPointsPerPacket> fixed(room.data(), room.size());
   std::size_t count = 0;
   const std::size_t before = done.size();
-  if (const auto offset_s = assembler_.in_frame_offset_s(azimuths, sensor)) {
+  if (const auto offset_s = assembler_.in_frame_offset_s(azimuths.bounds(), sensor)) {
     // Nearly every packet: inside the frame under way, so the decoder writes the frame-relative times itself and
     // the assembler need not go over the points again.
-    count = decoder_->decode_accepted(payload, header, fixed, offset_s);
+    count = decoder_->decode_accepted(payload, header, azimuths, fixed, offset_s);
     assembler_.commit_in_frame(count);
   } else {
-    count = decoder_->decode_accepted(payload, header, fixed, std::nullopt);
-    assembler_.commit(count, sensor, host_time, done, azimuths);
+    count = decoder_->decode_accepted(payload, header, azimuths, fixed, std::nullopt);
+    assembler_.commit(count, sensor, host_time, done, azimuths.bounds());
   }
   ++counters_.decoded;
   counters_.points += count;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -118,21 +119,22 @@ void compare_packets(const std::vector<std::vector<std::uint8_t>>& packets, cons
       ++diff.bounded;
       EXPECT_LT(bounds.max_cdeg, 36000) << what << " packet " << k;
     }
-    // velodyne::Stream's steps: the same bounds from the azimuths alone, the same points from decode_accepted(),
-    // and with a time offset the times RotationAssembler::commit() would make of them, nothing else changed.
-    const AzimuthRange early = fast.azimuth_bounds(packets[k], *h);
-    EXPECT_EQ(early.min_cdeg, bounds.min_cdeg) << what << " packet " << k;
-    EXPECT_EQ(early.max_cdeg, bounds.max_cdeg) << what << " packet " << k;
+    // velodyne::Stream's steps: the same bounds from the azimuths alone (azimuths(), read once), the same points
+    // byte for byte from decode_accepted() with those azimuths, and with a time offset the times
+    // RotationAssembler::commit() would make of them, nothing else changed.
+    const Decoder::PacketAzimuths early = fast.azimuths(packets[k], *h);
+    EXPECT_EQ(early.bounds().min_cdeg, bounds.min_cdeg) << what << " packet " << k;
+    EXPECT_EQ(early.bounds().max_cdeg, bounds.max_cdeg) << what << " packet " << k;
     const std::span<LidarPoint, Decoder::kMaxPointsPerPacket> fixed(room);
     std::memset(static_cast<void*>(room.data()), 0x5A, room.size() * sizeof(LidarPoint));
-    ASSERT_EQ(fast.decode_accepted(packets[k], *h, fixed, std::nullopt), a.size()) << what << " packet " << k;
+    ASSERT_EQ(fast.decode_accepted(packets[k], *h, early, fixed, std::nullopt), a.size()) << what << " packet " << k;
     ASSERT_EQ(std::memcmp(static_cast<const void*>(room.data()), static_cast<const void*>(a.data()),
                           a.size() * sizeof(LidarPoint)),
               0)
         << what << " packet " << k << ": decode_accepted() differs";
     for (const double offset : {0.1234567891, -0.0421, 0.0}) {
       std::memset(static_cast<void*>(room.data()), 0x77, room.size() * sizeof(LidarPoint));
-      ASSERT_EQ(fast.decode_accepted(packets[k], *h, fixed, offset), a.size()) << what << " packet " << k;
+      ASSERT_EQ(fast.decode_accepted(packets[k], *h, early, fixed, offset), a.size()) << what << " packet " << k;
       std::vector<LidarPoint> shifted = a;
       for (auto& p : shifted) p.time_s = static_cast<float>(offset + static_cast<double>(p.time_s));
       ASSERT_EQ(std::memcmp(static_cast<const void*>(room.data()), static_cast<const void*>(shifted.data()),
@@ -292,7 +294,8 @@ TEST(VelodyneDecoderFast, RandomPacketsMatchTheReferenceDecoder) {
 
 // The azimuth table's own error: every whole and many fractional azimuths at 130 m, against cos/sin in double of
 // the very float azimuth the decoder computes (replicated here), so that only the table's error is measured.
-// decode_accepted() is for packets read_packet_header() and accept() passed: anything else decodes to nothing.
+// decode_accepted() is for packets read_packet_header() and accept() passed, with their azimuths(): anything else
+// decodes to nothing.
 TEST(VelodyneDecoderFast, DecodeAcceptedRefusesWhatDecodeRefuses) {
   const auto packets = capture("hdl32e_monterey_600.pcap");
   ASSERT_FALSE(packets.empty());
@@ -304,21 +307,139 @@ TEST(VelodyneDecoderFast, DecodeAcceptedRefusesWhatDecodeRefuses) {
   o.model = Model::HDL32E;
   const Decoder hdl(default_calibration(Model::HDL32E), o);
   EXPECT_FALSE(hdl.accept(*header).has_value());
-  EXPECT_GT(hdl.decode_accepted(packets.front(), *header, fixed, std::nullopt), 0U);
+  const Decoder::PacketAzimuths az = hdl.azimuths(packets.front(), *header);
+  EXPECT_GT(hdl.decode_accepted(packets.front(), *header, az, fixed, std::nullopt), 0U);
   // Too short a payload for the header it is given.
   const std::vector<std::uint8_t> cut(packets.front().begin(), packets.front().begin() + 600);
-  EXPECT_EQ(hdl.decode_accepted(cut, *header, fixed, 0.5), 0U);
-  EXPECT_EQ(hdl.azimuth_bounds(cut, *header).max_cdeg, 0xFFFF);
+  EXPECT_EQ(hdl.decode_accepted(cut, *header, az, fixed, 0.5), 0U);
+  const Decoder::PacketAzimuths cut_az = hdl.azimuths(cut, *header);
+  EXPECT_EQ(cut_az.bounds().min_cdeg, 0);
+  EXPECT_EQ(cut_az.bounds().max_cdeg, 0xFFFF);
+  EXPECT_EQ(hdl.decode_accepted(packets.front(), *header, cut_az, fixed, 0.5), 0U);
+  // Azimuths made by no decoder.
+  EXPECT_EQ(hdl.decode_accepted(packets.front(), *header, Decoder::PacketAzimuths{}, fixed, std::nullopt), 0U);
+  // Azimuths of the other return layout (dual: 6 groups, not 12).
+  PacketHeader dual = *header;
+  dual.return_mode = ReturnMode::Dual;
+  EXPECT_EQ(hdl.decode_accepted(packets.front(), dual, az, fixed, std::nullopt), 0U);
+  EXPECT_EQ(hdl.decode_accepted(packets.front(), *header, hdl.azimuths(packets.front(), dual), fixed, std::nullopt),
+            0U);
+  // A block azimuth read_packet_header() would refuse (36000 or more): no bounds, nothing decoded.
+  std::vector<std::uint8_t> bad_azimuth = packets.front();
+  bad_azimuth[kBlockSize * 5 + 2] = 0xFF;
+  bad_azimuth[kBlockSize * 5 + 3] = 0xFF;
+  ASSERT_FALSE(read_packet_header(bad_azimuth).has_value());
+  const Decoder::PacketAzimuths bad_az = hdl.azimuths(bad_azimuth, *header);
+  EXPECT_EQ(bad_az.bounds().max_cdeg, 0xFFFF);
+  EXPECT_EQ(hdl.decode_accepted(bad_azimuth, *header, bad_az, fixed, std::nullopt), 0U);
   // A product byte of another sensor: ModelMismatch, as decode() says.
   PacketHeader other = *header;
   other.product_byte = 0x28;
   EXPECT_EQ(hdl.accept(other), DecodeError::ModelMismatch);
-  EXPECT_EQ(hdl.decode_accepted(packets.front(), other, fixed, std::nullopt), 0U);
+  EXPECT_EQ(hdl.decode_accepted(packets.front(), other, az, fixed, std::nullopt), 0U);
   // No model: NoModel.
   o.model = Model::Unknown;
   const Decoder none(default_calibration(Model::HDL32E), o);
   EXPECT_EQ(none.accept(*header), DecodeError::NoModel);
-  EXPECT_EQ(none.decode_accepted(packets.front(), *header, fixed, std::nullopt), 0U);
+  EXPECT_EQ(none.decode_accepted(packets.front(), *header, az, fixed, std::nullopt), 0U);
+}
+
+// A decoder given the azimuths another decoder read (other azimuth corrections) does not trust their bounds: its
+// points are still exactly its own decode()'s, also where its corrections carry firings across 0 that the other
+// decoder's bounds would call unwrapped.
+TEST(VelodyneDecoderFast, DecodeAcceptedIgnoresBoundsOfOtherCorrections) {
+  DecoderOptions o;
+  o.model = Model::HDL32E;
+  const Decoder plain(default_calibration(Model::HDL32E), o);
+  Calibration turned = default_calibration(Model::HDL32E);
+  for (auto& laser : turned.lasers) laser.rot_deg = 20.0;  // every firing 20 degrees back: past 0 near azimuth 0
+  const Decoder shifted(turned, o);
+  std::vector<LidarPoint> room(Decoder::kMaxPointsPerPacket);
+  const std::span<LidarPoint, Decoder::kMaxPointsPerPacket> fixed(room);
+  std::vector<LidarPoint> want;
+  std::size_t compared = 0;
+  for (const int first_cdeg : {5, 300, 1000, 1900, 2100, 18000, 35900}) {
+    PacketBuilder b;
+    for (std::size_t blk = 0; blk < kBlocksPerPacket; ++blk) {
+      b.azimuth(blk, static_cast<std::uint16_t>((first_cdeg + static_cast<int>(blk) * 9) % 36000));
+      for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {
+        b.slot(blk, slot, static_cast<std::uint16_t>(1000 + 37 * slot + blk), static_cast<std::uint8_t>(slot));
+      }
+    }
+    const std::vector<std::uint8_t> packet = b.bytes();
+    const auto h = read_packet_header(packet);
+    ASSERT_TRUE(h.has_value());
+    const Decoder::PacketAzimuths foreign = plain.azimuths(packet, *h);
+    want.clear();
+    ASSERT_TRUE(shifted.decode(packet, want).has_value());
+    std::memset(static_cast<void*>(room.data()), 0x11, room.size() * sizeof(LidarPoint));
+    ASSERT_EQ(shifted.decode_accepted(packet, *h, foreign, fixed, std::nullopt), want.size()) << first_cdeg;
+    ASSERT_FALSE(want.empty());
+    EXPECT_EQ(std::memcmp(static_cast<const void*>(room.data()), static_cast<const void*>(want.data()),
+                          want.size() * sizeof(LidarPoint)),
+              0)
+        << "first azimuth " << first_cdeg;
+    compared += want.size();
+  }
+  EXPECT_GT(compared, 0U);
+}
+
+// The integer range test (raw distance bounds per slot, worked out at construction) keeps exactly the returns the
+// float test keeps, for every raw distance of every slot, under calibrations and limits that put the bounds
+// anywhere: none kept, all kept, a distance correction that keeps or drops raw 0's range, non-finite limits.
+TEST(VelodyneDecoderFast, RangeTestInIntegersMatchesFloatTest) {
+  struct Case {
+    double dist_m;  // every laser's distance correction
+    double min_m;
+    double max_m;
+    double resolution_m;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Case cases[] = {{0.0, 0.5, 130.0, 0.002},  {1.2, 0.5, 130.0, 0.002},  {-0.3, 0.0, 130.0, 0.002},
+                        {0.0, 0.0, inf, 0.002},    {0.0, 131.0, 130.0, 0.002}, {0.0, 0.5, 130.0, 0.004},
+                        {0.0, nan, 130.0, 0.002},  {0.0, 0.5, nan, 0.002},     {2.0, 2.0, 2.0, 0.002},
+                        {0.0, 0.5, 1e-3, 1e-7},    {-inf, 0.5, 130.0, 0.002},  {nan, 0.5, 130.0, 0.002}};
+  std::size_t cases_run = 0;
+  for (const Case& c : cases) {
+    Calibration cal = default_calibration(Model::VLP16);
+    cal.distance_resolution_m = c.resolution_m;
+    for (std::size_t j = 0; j < cal.lasers.size(); ++j) {
+      cal.lasers[j].dist_m = c.dist_m + (std::isfinite(c.dist_m) ? 0.001 * static_cast<double>(j) : 0.0);
+    }
+    DecoderOptions o;
+    o.model = Model::VLP16;
+    o.min_range_m = c.min_m;
+    o.max_range_m = c.max_m;
+    const Decoder d(cal, o);
+    // Every raw distance 0..65535 in some slot of some block: 12 blocks x 32 slots per packet, the raw values
+    // stepped so that each slot meets every value across the packets.
+    std::vector<LidarPoint> got;
+    const auto res = static_cast<float>(c.resolution_m);
+    const auto min_r = static_cast<float>(c.min_m);
+    const auto max_r = static_cast<float>(c.max_m);
+    std::size_t kept_want = 0;
+    std::size_t kept_got = 0;
+    for (std::uint32_t base = 0; base < 0x10000; base += kBlocksPerPacket) {
+      PacketBuilder b;
+      for (std::size_t blk = 0; blk < kBlocksPerPacket; ++blk) {
+        b.azimuth(blk, static_cast<std::uint16_t>(18000 + 10 * blk));
+        for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {
+          const auto raw = static_cast<std::uint16_t>((base + blk + 4096 * (slot % 16)) & 0xFFFF);
+          b.slot(blk, slot, raw, 7);
+          const float dist = static_cast<float>(cal.lasers[slot % 16].dist_m);
+          const float range = static_cast<float>(raw) * res + dist;
+          if (raw != 0 && range >= min_r && range <= max_r) ++kept_want;
+        }
+      }
+      got.clear();
+      ASSERT_TRUE(d.decode(b.bytes(), got).has_value());
+      kept_got += got.size();
+    }
+    EXPECT_EQ(kept_got, kept_want) << "dist " << c.dist_m << " limits " << c.min_m << ".." << c.max_m;
+    ++cases_run;
+  }
+  EXPECT_EQ(cases_run, std::size(cases));
 }
 
 TEST(VelodyneDecoderFast, AzimuthTableErrorAt130m) {

@@ -67,39 +67,60 @@ class Decoder {
   Expected<PacketHeader, DecodeError> decode(ByteSpan payload, std::span<LidarPoint, kMaxPointsPerPacket> room,
                                              std::size_t& count, AzimuthRange& azimuths) const;
 
+  // A packet's firing-group azimuths, read once from its block azimuths for both of velodyne::Stream's steps: their
+  // bounds decide whether the packet lies inside the frame under way (RotationAssembler::in_frame_offset_s()), and
+  // decode_accepted() decodes with them instead of reading them again. Made only by azimuths().
+  class PacketAzimuths {
+   public:
+    // The bounds decode() gives with the points: AzimuthRange{} (every azimuth) where the firings' azimuths may
+    // wrap past 0 inside the packet, or for a payload read_packet_header() would refuse.
+    [[nodiscard]] AzimuthRange bounds() const { return bounds_; }
+
+   private:
+    friend class Decoder;
+    std::array<float, kBlocksPerPacket> az_{};     // azimuth of each firing group (single return: 12, dual: 6)
+    std::array<float, kBlocksPerPacket> delta_{};  // its step to the next group
+    AzimuthRange bounds_;
+    // The azimuth corrections the bounds were worked out with: decode_accepted() trusts them only where they are
+    // its own (bit for bit), so that no PacketAzimuths can make it skip a wrap it needs.
+    std::uint32_t min_rot_bits_ = 0;
+    std::uint32_t max_rot_bits_ = 0;
+    bool dual_ = false;
+    bool valid_ = false;  // a 1206-byte payload whose block azimuths are all below 36000
+  };
+
   // The steps of decode(), for velodyne::Stream, which has read the header (read_packet_header()) already and wants
   // the point times frame-relative straight from the decoder (RotationAssembler::in_frame_offset_s()):
   //  - accept(): the model checks decode() makes on top of read_packet_header() (NoModel, ModelMismatch);
-  //  - azimuth_bounds(): the bounds decode() gives, from the block azimuths alone (before decoding the points);
+  //  - azimuths(): the packet's group azimuths and the bounds decode() gives (before decoding the points);
   //  - decode_accepted(): the points of a packet accept() accepted, as decode() writes them, except that with a
   //    time_offset_s every time_s is float(time_offset_s + double(the packet-relative time)): exactly what
-  //    RotationAssembler::commit() makes of it.
+  //    RotationAssembler::commit() makes of it. `azimuths` must be azimuths() of the same payload and header;
+  //    anything else (a payload of another length, another return layout, bad azimuths) decodes to nothing.
   [[nodiscard]] std::optional<DecodeError> accept(const PacketHeader& header) const;
-  [[nodiscard]] AzimuthRange azimuth_bounds(ByteSpan payload, const PacketHeader& header) const;
+  [[nodiscard]] PacketAzimuths azimuths(ByteSpan payload, const PacketHeader& header) const;
   [[nodiscard]] std::size_t decode_accepted(ByteSpan payload, const PacketHeader& header,
+                                            const PacketAzimuths& azimuths,
                                             std::span<LidarPoint, kMaxPointsPerPacket> room,
                                             std::optional<double> time_offset_s) const;
 
   [[nodiscard]] Model model() const { return options_.model; }
 
  private:
-  // Azimuth of each firing group of a packet and its step to the next group (single return: 12 groups, dual: 6).
-  struct GroupAzimuths {
-    std::array<float, kBlocksPerPacket> az{};
-    std::array<float, kBlocksPerPacket> delta{};
-  };
   [[nodiscard]] Expected<PacketHeader, DecodeError> check(ByteSpan payload) const;
-  [[nodiscard]] std::size_t decode_checked(ByteSpan payload, const PacketHeader& header, LidarPoint* room,
-                                           AzimuthRange* azimuths, std::optional<double> time_offset_s) const;
+  // azimuths() of a payload read_packet_header() accepted with `dual` (its layout), length already checked.
   template <bool kDual>
-  [[nodiscard]] AzimuthRange bounds_of(const GroupAzimuths& groups) const;
+  [[nodiscard]] PacketAzimuths read_azimuths(const std::uint8_t* bytes) const;
+  [[nodiscard]] std::size_t decode_checked(const std::uint8_t* bytes, const PacketHeader& header,
+                                           const PacketAzimuths& azimuths, LidarPoint* room,
+                                           std::optional<double> time_offset_s) const;
   // How a firing's azimuth is brought into [0, 36000): not at all (the packet's azimuth bounds lie inside the turn),
   // by one add or subtract of a turn (fast_wrap_), or by fmod and libm cos/sin (corrections beyond 350 degrees).
   enum class Wrap : std::uint8_t { None, Fast, General };
-  template <bool kDual, Wrap kWrap>
+  template <bool kDual, Wrap kWrap, bool kFrameTimes>
   [[nodiscard]] std::size_t decode_points(const std::uint8_t* bytes, const PacketHeader& header,
-                                          const GroupAzimuths& groups, const float* times,
-                                          std::optional<double> time_offset_s, LidarPoint* dst) const;
+                                          const PacketAzimuths& groups, const float* times, double time_offset_s,
+                                          LidarPoint* dst) const;
 
   DecoderOptions options_;
   Calibration calibration_;
@@ -121,6 +142,11 @@ class Decoder {
     // here exactly as they would be there (one float multiply), so that a point costs two multiplies fewer.
     std::array<float, kSlotsPerBlock> vert_offset_sin;
     std::array<float, kSlotsPerBlock> vert_offset_cos;
+    // The raw distances (units of the resolution) whose return is kept: raw_above < raw < raw_below. The range test
+    // in integers, worked out at construction from the float test it replaces (min_range_m <= range <= max_range_m
+    // and raw != 0; range = float(raw) * resolution + dist_m rises with raw), so that it keeps the same returns.
+    std::array<std::int32_t, kSlotsPerBlock> raw_above;
+    std::array<std::int32_t, kSlotsPerBlock> raw_below;
   };
   SlotTables slots_{};
   // Time of each firing of a packet (s), relative to the firing the packet timestamp marks: [0] single return
