@@ -25,6 +25,8 @@ double cross(const P2& o, const P2& a, const P2& b) {
 
 std::string_view to_string(SizeClass c) { return c == SizeClass::Small ? "small" : "large"; }
 
+namespace {
+
 // A float's bits as an unsigned integer in the same order (negatives flipped): (x, y) then sorts as one
 // 64-bit integer, and the mapping is one to one, so sorting the integers sorts the points exactly.
 std::uint64_t ordered_bits(float v) {
@@ -40,8 +42,10 @@ float from_ordered_bits(std::uint64_t o) {
   return v;
 }
 
-// Sorts points by (x, y): std::sort when few, else an LSD radix sort of their 64-bit keys (six 11-bit
-// passes: linear in the count, where a comparison sort of a wall's thousands of points is not).
+// Sorts points by (x, y): std::sort when few; else by their 64-bit keys, with std::sort up to a few thousand
+// and above that an LSD radix sort (six 11-bit passes: linear in the count, but each pass clears and sums 2048
+// counters, which costs more than a comparison sort of the hundreds of points a pre-filtered wall leaves).
+// Both key sorts give the one order of the keys, so the same points whichever runs.
 void sort_points(std::vector<P2>& pts, HullScratch& s) {
   const std::size_t n = pts.size();
   if (n <= 256) {
@@ -49,28 +53,41 @@ void sort_points(std::vector<P2>& pts, HullScratch& s) {
     return;
   }
   s.keys.resize(n);
-  s.keys_tmp.resize(n);
   for (std::size_t i = 0; i < n; ++i) s.keys[i] = (ordered_bits(pts[i][0]) << 32U) | ordered_bits(pts[i][1]);
-  constexpr unsigned kBits = 11;  // six passes over 2048 counters
-  constexpr std::uint64_t kMask = (std::uint64_t{1} << kBits) - 1;
-  std::vector<std::uint32_t>& count = s.counts;
-  count.resize(std::size_t{1} << kBits);
-  for (unsigned shift = 0; shift < 64; shift += kBits) {
-    std::fill(count.begin(), count.end(), 0U);
-    for (const std::uint64_t k : s.keys) ++count[(k >> shift) & kMask];
-    std::uint32_t sum = 0;
-    for (auto& c : count) {
-      const std::uint32_t v = c;
-      c = sum;
-      sum += v;
+  if (n <= 4096) {
+    std::sort(s.keys.begin(), s.keys.end());
+  } else {
+    s.keys_tmp.resize(n);
+    constexpr unsigned kBits = 11;  // six passes over 2048 counters
+    constexpr std::uint64_t kMask = (std::uint64_t{1} << kBits) - 1;
+    std::vector<std::uint32_t>& count = s.counts;
+    count.resize(std::size_t{1} << kBits);
+    for (unsigned shift = 0; shift < 64; shift += kBits) {
+      std::fill(count.begin(), count.end(), 0U);
+      for (const std::uint64_t k : s.keys) ++count[(k >> shift) & kMask];
+      std::uint32_t sum = 0;
+      for (auto& c : count) {
+        const std::uint32_t v = c;
+        c = sum;
+        sum += v;
+      }
+      for (const std::uint64_t k : s.keys) s.keys_tmp[count[(k >> shift) & kMask]++] = k;
+      s.keys.swap(s.keys_tmp);
     }
-    for (const std::uint64_t k : s.keys) s.keys_tmp[count[(k >> shift) & kMask]++] = k;
-    s.keys.swap(s.keys_tmp);
   }
   for (std::size_t i = 0; i < n; ++i) pts[i] = P2{from_ordered_bits(s.keys[i] >> 32U), from_ordered_bits(s.keys[i])};
 }
 
-namespace {
+// Beyond this coordinate magnitude the octagon pre-filter and the shared count of points on the sides are not
+// used: their float tests could overflow (a footprint never comes near it).
+constexpr float kFilterReach = 1e18F;
+
+// What drop_interior() saw of the points: all finite and within kFilterReach (else drop_interior_16() filtered
+// them), and the largest coordinate magnitude.
+struct Seen {
+  bool tame = false;
+  float reach = 0.F;
+};
 
 // Directions of the extreme points that span the pre-filter's polygon: 16, counter-clockwise from -x.
 constexpr std::size_t kHullDirs = 16;
@@ -85,13 +102,15 @@ struct HullDirs {
   }
 };
 
-// Leaves out of `all` the points that cannot be hull vertices, into `kept` (input order): the points extreme
-// along 16 directions span a polygon inside the hull, and a point strictly inside every edge of it is no hull
+// The pre-filter for a footprint drop_interior() does not vouch for (a coordinate not finite or beyond
+// kFilterReach), kept as it was before the octagon so that such a footprint's hull stays what it was: with NaN
+// the monotone chain's result depends on which points it sees. It leaves out of `all` the points that cannot be
+// hull vertices, into `kept` (input order): the points extreme along 16 directions span a polygon inside the hull, and a point strictly inside every edge of it is no hull
 // vertex (strictly left of every edge of a closed chain of input points means inside their hull, whatever
 // their order). The test is in float, so a point is left out only when it is inside by a margin far above the
 // float error of the test; points on or near an edge are kept and the exact hull below decides.
 // Most of a dense footprint (a wall of thousands of points) is left out.
-void drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
+void drop_interior_16(std::span<const P2> all, std::vector<P2>& kept) {
   static const HullDirs dirs;
   const std::size_t n = all.size();
   // Extreme points four at a time: per direction and lane the best value and the first index reaching it,
@@ -200,6 +219,265 @@ void drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
   }
 }
 
+// The line of the edge from a along (dx, dy) for the in-polygon test of points q taken from the corner o:
+// q is strictly left of it when dx * qy - dy * qx > dx * (ay - oy) - dy * (ax - ox), and is taken as inside only
+// when it is so by tol more. |dx * qy - dy * qx| <= (|dx| + |dy|) * span, and each float operation of the test
+// (the two differences from o, two products, one difference; the limit rounded to float) errs by 2^-24 of that
+// at most: 1e-5 of the bound is some thirty times the worst error.
+struct EdgeLine {
+  float dx, dy, limit;
+  float beyond;  // dx * qy - dy * qx below this: q is outside the line by the margin
+};
+EdgeLine edge_line(const P2& a, const P2& b, float ox, float oy, float span) {
+  const float dx = b[0] - a[0], dy = b[1] - a[1];
+  const double tol = 1e-5 * (std::fabs(d(dx)) + std::fabs(d(dy))) * (d(span) + 1.0);
+  const double c = d(dx) * (d(a[1]) - d(oy)) - d(dy) * (d(a[0]) - d(ox));
+  return {dx, dy, static_cast<float>(c + tol), static_cast<float>(c - tol)};
+}
+
+// A second round over the points the octagon kept (a wall's outer face: hundreds of points along each edge,
+// outside it by their noise): each edge with kept points outside it gets the farthest of them as a corner
+// between its ends (a hull vertex), and the kept points are tested again against that polygon of up to 16
+// corners, in place, order kept. Whatever corners are chosen, the polygon is a closed chain of input points:
+// the test stays exact. `corners`: the octagon's, counter-clockwise; o = (ox, oy) and span as drop_interior's.
+void refine(std::vector<P2>& kept, std::span<const P2> corners, float ox, float oy, float span) {
+  constexpr std::size_t kMax = 16;
+  const std::size_t n = kept.size(), m = corners.size();
+  if (n < 64 || m < 3 || m > kMax / 2) return;
+  // The farthest outside each edge: the least dx * qy - dy * qx (in float; any choice keeps the test exact).
+  std::array<float, kMax / 2> least{};
+  std::array<std::size_t, kMax / 2> at{};
+  std::array<EdgeLine, kMax / 2> line{};
+  for (std::size_t e = 0; e < m; ++e) {
+    line[e] = edge_line(corners[e], corners[(e + 1) % m], ox, oy, span);
+    least[e] = line[e].beyond;
+    at[e] = n;
+  }
+  {  // four at a time, per lane the least and its first index, then the lanes (the least, then the first)
+    std::array<simd::f32x4, kMax / 2> lv{};
+    std::array<simd::i32x4, kMax / 2> li{};
+    for (std::size_t e = 0; e < m; ++e) {
+      lv[e] = simd::splat(least[e]);
+      li[e] = simd::splat(static_cast<std::int32_t>(n));
+    }
+    const simd::f32x4 vox = simd::splat(ox), voy = simd::splat(oy);
+    simd::i32x4 idx{0, 1, 2, 3};
+    const std::size_t n4 = n - n % 4;
+    for (std::size_t i = 0; i < n4; i += 4, idx += 4) {
+      simd::f32x4 a, b;
+      std::memcpy(&a, &kept[i], sizeof a);
+      std::memcpy(&b, &kept[i + 2], sizeof b);
+      const simd::f32x4 qx = __builtin_shufflevector(a, b, 0, 2, 4, 6) - vox;
+      const simd::f32x4 qy = __builtin_shufflevector(a, b, 1, 3, 5, 7) - voy;
+      for (std::size_t e = 0; e < m; ++e) {
+        const simd::f32x4 g = simd::splat(line[e].dx) * qy - simd::splat(line[e].dy) * qx;
+        const simd::i32x4 lower = g < lv[e];
+        lv[e] = simd::min_or_bound(g, lv[e]);
+        li[e] = lower ? idx : li[e];
+      }
+    }
+    for (std::size_t e = 0; e < m; ++e) {
+      for (std::size_t j = 0; j < 4; ++j) {
+        const auto i = static_cast<std::size_t>(li[e][j]);
+        if (lv[e][j] < least[e] || (lv[e][j] == least[e] && i < at[e])) {
+          least[e] = lv[e][j];
+          at[e] = i;
+        }
+      }
+    }
+    for (std::size_t i = n4; i < n; ++i) {
+      const float qx = kept[i][0] - ox, qy = kept[i][1] - oy;
+      for (std::size_t e = 0; e < m; ++e) {
+        const float g = line[e].dx * qy - line[e].dy * qx;
+        if (g < least[e]) {
+          least[e] = g;
+          at[e] = i;
+        }
+      }
+    }
+  }
+  std::array<P2, kMax> chain{};
+  std::size_t c = 0;
+  for (std::size_t e = 0; e < m; ++e) {
+    chain[c++] = corners[e];
+    if (at[e] < n) chain[c++] = kept[at[e]];
+  }
+  if (c == m) return;  // nothing outside any edge: the same polygon again
+  std::array<simd::f32x4, kMax> ex{}, ey{}, limit{};
+  for (std::size_t k = 0; k < kMax; ++k) {
+    const EdgeLine l = k < c ? edge_line(chain[k], chain[(k + 1) % c], ox, oy, span) : edge_line(chain[0], chain[1], ox, oy, span);
+    ex[k] = simd::splat(l.dx);
+    ey[k] = simd::splat(l.dy);
+    limit[k] = simd::splat(l.limit);
+  }
+  const simd::f32x4 vox = simd::splat(ox), voy = simd::splat(oy);
+  std::size_t w = 0, i = 0;
+  for (; i + 4 <= n; i += 4) {
+    simd::f32x4 a, b;
+    std::memcpy(&a, &kept[i], sizeof a);
+    std::memcpy(&b, &kept[i + 2], sizeof b);
+    const simd::f32x4 qx = __builtin_shufflevector(a, b, 0, 2, 4, 6) - vox, qy = __builtin_shufflevector(a, b, 1, 3, 5, 7) - voy;
+    const auto left = [&](std::size_t k) { return (ex[k] * qy - ey[k] * qx) > limit[k]; };
+    const simd::i32x4 inside = ((left(0) & left(1)) & (left(2) & left(3))) & ((left(4) & left(5)) & (left(6) & left(7))) &
+                               ((left(8) & left(9)) & (left(10) & left(11))) & ((left(12) & left(13)) & (left(14) & left(15)));
+    const unsigned mask = simd::mask_bits(inside);
+    for (std::size_t j = 0; j < 4; ++j) {
+      if ((mask & (1U << j)) == 0U) kept[w++] = kept[i + j];
+    }
+  }
+  for (; i < n; ++i) {
+    const float qx = kept[i][0] - ox, qy = kept[i][1] - oy;
+    bool inside = true;
+    for (std::size_t k = 0; k < kMax; ++k) inside = inside && (ex[k][0] * qy - ey[k][0] * qx) > limit[k][0];
+    if (!inside) kept[w++] = kept[i];
+  }
+  kept.resize(w);
+}
+
+// Leaves out of `all` the points that cannot be hull vertices, into `kept` (input order): the points extreme
+// along 8 directions (along and across the axes: the x, y, x + y and x - y of each point, whose least and
+// greatest need no multiplication) span a polygon inside the hull, and a point strictly inside every edge of it
+// is no hull vertex (strictly left of every edge of a closed chain of input points means inside their hull,
+// whatever their order). The test is in float, so a point is left out only when it is inside by a margin far
+// above the float error of the test; points on or near an edge are kept and the exact hull below decides. Which
+// points are left out does not change the hull (its vertices are all kept), only how many the sort sees. Most of
+// a dense footprint is left out: of the 9,483 points of a shed's three walls the octagon keeps 827 (16 even
+// directions kept 697 at twice the cost), refine() all but 62 of those. A point not finite, or one beyond
+// kFilterReach: drop_interior_16() instead.
+Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
+  const std::size_t n = all.size();
+  const auto load4 = [&](std::size_t i, simd::f32x4& px, simd::f32x4& py) {
+    simd::f32x4 a, b;
+    std::memcpy(&a, &all[i], sizeof a);
+    std::memcpy(&b, &all[i + 2], sizeof b);
+    px = __builtin_shufflevector(a, b, 0, 2, 4, 6);
+    py = __builtin_shufflevector(a, b, 1, 3, 5, 7);
+  };
+  // The least and greatest x, y, x + y and x - y, four lanes at a time, values only (the points reaching them are
+  // found after: tracking indices too doubled this loop).
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  simd::f32x4 lo_x = simd::splat(kInf), lo_y = lo_x, lo_s = lo_x, lo_d = lo_x;
+  simd::f32x4 hi_x = simd::splat(-kInf), hi_y = hi_x, hi_s = hi_x, hi_d = hi_x;
+  simd::f32x4 wild = simd::splat(0.F);  // NaN from here on once a point is not finite (or x + y overflows)
+  const std::size_t n4 = n - n % 4;
+  for (std::size_t i = 0; i < n4; i += 4) {
+    simd::f32x4 px, py;
+    load4(i, px, py);
+    const simd::f32x4 ps = px + py, pd = px - py;
+    wild += ps - ps;  // x + y is not finite when x or y is not
+    lo_x = simd::min_or_bound(px, lo_x);
+    hi_x = simd::max_or_bound(px, hi_x);
+    lo_y = simd::min_or_bound(py, lo_y);
+    hi_y = simd::max_or_bound(py, hi_y);
+    lo_s = simd::min_or_bound(ps, lo_s);
+    hi_s = simd::max_or_bound(ps, hi_s);
+    lo_d = simd::min_or_bound(pd, lo_d);
+    hi_d = simd::max_or_bound(pd, hi_d);
+  }
+  // Per extreme, counter-clockwise by direction: +x, +(x + y), +y, -(x - y), -x, -(x + y), -y, +(x - y); the
+  // greatest of value * sign.
+  constexpr std::size_t kExt = 8;
+  const std::array<simd::f32x4, kExt> lanes{hi_x, hi_s, hi_y, lo_d, lo_x, lo_s, lo_y, hi_d};
+  constexpr std::array<float, kExt> sign{1.F, 1.F, 1.F, -1.F, -1.F, -1.F, -1.F, 1.F};
+  const auto project = [](float x, float y, std::size_t k) {
+    const std::array<float, kExt> v{x, x + y, y, x - y, x, x + y, y, x - y};
+    return v[k];
+  };
+  std::array<float, kExt> best{};
+  bool finite = true;
+  for (std::size_t k = 0; k < kExt; ++k) {
+    best[k] = -kInf;
+    for (std::size_t j = 0; j < 4 && n4 > 0; ++j) best[k] = std::max(best[k], sign[k] * lanes[k][j]);
+  }
+  for (std::size_t j = 0; j < 4 && n4 > 0; ++j) finite = finite && wild[j] == 0.F;
+  for (std::size_t i = n4; i < n; ++i) {  // the last few, one by one
+    finite = finite && std::isfinite(all[i][0] + all[i][1]);
+    for (std::size_t k = 0; k < kExt; ++k) best[k] = std::max(best[k], sign[k] * project(all[i][0], all[i][1], k));
+  }
+  const float min_x = -best[4], max_x = best[0], min_y = -best[6], max_y = best[2];
+  const float reach = std::max(std::max(std::fabs(min_x), std::fabs(max_x)), std::max(std::fabs(min_y), std::fabs(max_y)));
+  if (!finite || !(reach <= kFilterReach)) {
+    drop_interior_16(all, kept);
+    return Seen{false, reach};
+  }
+  // The first point reaching each extreme (deterministic), in one scan that ends when all are found.
+  std::array<std::size_t, kExt> ext{};
+  unsigned missing = (1U << kExt) - 1U;
+  const auto check = [&](std::size_t i) {
+    for (std::size_t k = 0; k < kExt; ++k) {
+      if ((missing & (1U << k)) != 0U && sign[k] * project(all[i][0], all[i][1], k) == best[k]) {
+        ext[k] = i;
+        missing &= ~(1U << k);
+      }
+    }
+  };
+  {
+    const simd::f32x4 bx0 = simd::splat(max_x), bx1 = simd::splat(min_x), by0 = simd::splat(max_y),
+                      by1 = simd::splat(min_y), bs0 = simd::splat(best[1]), bs1 = simd::splat(-best[5]),
+                      bd0 = simd::splat(best[7]), bd1 = simd::splat(-best[3]);
+    std::size_t i = 0;
+    for (; i < n4 && missing != 0U; i += 4) {
+      simd::f32x4 px, py;
+      load4(i, px, py);
+      const simd::f32x4 ps = px + py, pd = px - py;
+      const simd::i32x4 hit =
+          (px == bx0) | (px == bx1) | (py == by0) | (py == by1) | (ps == bs0) | (ps == bs1) | (pd == bd0) | (pd == bd1);
+      if (simd::mask_bits(hit) == 0U) continue;
+      for (std::size_t j = 0; j < 4; ++j) check(i + j);
+    }
+    for (i = std::max(i, n4); i < n && missing != 0U; ++i) check(i);
+  }
+  kept.clear();
+  // The polygon's edges without repeated corners (a corner extreme along several directions), as lines.
+  std::array<simd::f32x4, kExt> ex{}, ey{}, limit{};
+  std::array<P2, kExt> corner{};  // where each edge starts (it ends where the next starts)
+  std::size_t edges = 0;
+  const float span = std::max(max_x - min_x, max_y - min_y);
+  for (std::size_t k = 0; k < kExt; ++k) {
+    const P2& a = all[ext[k]];
+    const P2& b = all[ext[(k + 1) % kExt]];
+    if (a == b) continue;
+    const EdgeLine l = edge_line(a, b, min_x, min_y, span);
+    corner[edges] = a;
+    ex[edges] = simd::splat(l.dx);
+    ey[edges] = simd::splat(l.dy);
+    limit[edges] = simd::splat(l.limit);
+    ++edges;
+  }
+  if (edges < 3) {  // all points on one line, or nearly: nothing to leave out safely
+    kept.assign(all.begin(), all.end());
+    return Seen{true, reach};
+  }
+  for (std::size_t k = edges; k < kExt; ++k) {  // padded with the first edge: the test runs over all eight
+    ex[k] = ex[0];
+    ey[k] = ey[0];
+    limit[k] = limit[0];
+  }
+  const simd::f32x4 ox = simd::splat(min_x), oy = simd::splat(min_y);
+  std::size_t i = 0;
+  for (; i < n4; i += 4) {
+    simd::f32x4 px, py;
+    load4(i, px, py);
+    const simd::f32x4 qx = px - ox, qy = py - oy;
+    // Written out: g++ -O2 kept the loop over the edges, at twice the instructions.
+    const auto left = [&](std::size_t k) { return (ex[k] * qy - ey[k] * qx) > limit[k]; };
+    const simd::i32x4 inside = (left(0) & left(1)) & (left(2) & left(3)) & (left(4) & left(5)) & (left(6) & left(7));
+    const unsigned m = simd::mask_bits(inside);
+    if (m == 0xFU) continue;
+    for (std::size_t j = 0; j < 4; ++j) {
+      if ((m & (1U << j)) == 0U) kept.push_back(all[i + j]);
+    }
+  }
+  for (; i < n; ++i) {
+    const float qx = all[i][0] - min_x, qy = all[i][1] - min_y;
+    bool inside = true;
+    for (std::size_t k = 0; k < kExt; ++k) inside = inside && (ex[k][0] * qy - ey[k][0] * qx) > limit[k][0];
+    if (!inside) kept.push_back(all[i]);
+  }
+  refine(kept, {corner.data(), edges}, min_x, min_y, span);
+  return Seen{true, reach};
+}
+
 }  // namespace
 
 namespace {
@@ -239,11 +517,15 @@ std::size_t count_near_sides(std::span<const P2> pts, double ux, double uy, doub
 
 }  // namespace
 
-void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
+namespace {
+
+// convex_hull(), telling what the pre-filter saw (nothing when it did not run: 64 points or fewer).
+Seen hull_of(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
   hull.clear();
   std::vector<P2>& scratch = hs.points;
+  Seen seen;
   if (all.size() > 64) {
-    drop_interior(all, scratch);
+    seen = drop_interior(all, scratch);
   } else {
     scratch.assign(all.begin(), all.end());
   }
@@ -252,7 +534,7 @@ void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs
   const std::size_t n = pts.size();
   if (n <= 1) {
     hull.assign(pts.begin(), pts.end());
-    return;
+    return seen;
   }
   hull.resize(2 * n);
   std::size_t k = 0;
@@ -266,20 +548,88 @@ void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs
   }
   hull.resize(k - 1);  // the last point is the first
   if (hull.size() == 2 && hull[0] == hull[1]) hull.resize(1);
+  return seen;
+}
+
+struct Candidate {
+  double ux, uy, u0, u1, v0, v1, area;
+  // How near a side a point must be to count as on it.
+  [[nodiscard]] double tol() const { return std::max(0.05, 0.02 * std::max(u1 - u0, v1 - v0)); }
+  [[nodiscard]] std::size_t count(std::span<const P2> pts) const {
+    return count_near_sides(pts, ux, uy, u0, u1, v0, v1, tol());
+  }
+};
+
+// The points of `pts` that some of `cands` may not count (more than its tol() from each of its sides), into
+// `maybe`; every point left out is counted by every one of them. Each rectangle's region of uncounted points
+// (its inside shrunk by tol() on every side, grown by a slack far above the double error of count_near_sides'
+// test) is mapped into the first rectangle's axes, and a point is kept when it falls in the box around all of
+// them there, tested in float with a margin far above that test's float error. A footprint's points mostly
+// lie on its faces, near the sides of every near-least rectangle: few are kept (a shed's three walls, 9,500
+// points, keep 2). `reach`: the largest coordinate magnitude, at most kFilterReach; every point finite.
+void maybe_uncounted(std::span<const P2> pts, std::span<const Candidate* const> cands, float reach,
+                     std::vector<P2>& maybe) {
+  maybe.clear();
+  constexpr double kBig = std::numeric_limits<double>::max();
+  const double ax = cands[0]->ux, ay = cands[0]->uy;
+  double bu0 = kBig, bu1 = -kBig, bv0 = kBig, bv1 = -kBig;
+  const double slack = 1e-9 * (static_cast<double>(reach) + 1.0);
+  for (const Candidate* c : cands) {
+    const double tol = c->tol();
+    const double lu = c->u0 + tol - slack, hu = c->u1 - tol + slack;
+    const double lv = c->v0 + tol - slack, hv = c->v1 - tol + slack;
+    if (!(lu <= hu) || !(lv <= hv)) continue;  // narrower than 2 tol: every point near a side
+    for (const double u : {lu, hu}) {
+      for (const double v : {lv, hv}) {
+        const double x = u * c->ux - v * c->uy, y = u * c->uy + v * c->ux;
+        const double u1 = x * ax + y * ay, v1 = -x * ay + y * ax;
+        bu0 = std::min(bu0, u1);
+        bu1 = std::max(bu1, u1);
+        bv0 = std::min(bv0, v1);
+        bv1 = std::max(bv1, v1);
+      }
+    }
+  }
+  if (bu0 > bu1) return;
+  const float margin = 1e-5F * (reach + 1.F);
+  const simd::f32x4 fa = simd::splat(static_cast<float>(ax)), fb = simd::splat(static_cast<float>(ay));
+  const simd::f32x4 lu = simd::splat(static_cast<float>(bu0) - margin), hu = simd::splat(static_cast<float>(bu1) + margin);
+  const simd::f32x4 lv = simd::splat(static_cast<float>(bv0) - margin), hv = simd::splat(static_cast<float>(bv1) + margin);
+  const std::size_t n = pts.size();
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    simd::f32x4 a, b;
+    std::memcpy(&a, &pts[i], sizeof a);
+    std::memcpy(&b, &pts[i + 2], sizeof b);
+    const simd::f32x4 px = __builtin_shufflevector(a, b, 0, 2, 4, 6), py = __builtin_shufflevector(a, b, 1, 3, 5, 7);
+    const simd::f32x4 u = px * fa + py * fb, v = py * fa - px * fb;
+    const unsigned m = simd::mask_bits((u >= lu) & (u <= hu) & (v >= lv) & (v <= hv));
+    if (m == 0U) continue;
+    for (std::size_t j = 0; j < 4; ++j) {
+      if ((m & (1U << j)) != 0U) maybe.push_back(pts[i + j]);
+    }
+  }
+  for (; i < n; ++i) {
+    const float u = pts[i][0] * fa[0] + pts[i][1] * fb[0], v = pts[i][1] * fa[0] - pts[i][0] * fb[0];
+    if (u >= lu[0] && u <= hu[0] && v >= lv[0] && v <= hv[0]) maybe.push_back(pts[i]);
+  }
+}
+
+}  // namespace
+
+void convex_hull(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
+  static_cast<void>(hull_of(all, hull, hs));
 }
 
 OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, HullScratch& scratch) {
   OrientedRect r;
   if (pts.empty()) return r;
-  convex_hull(pts, hull, scratch);
+  const Seen seen = hull_of(pts, hull, scratch);
   const std::size_t h = hull.size();
   if (h == 1) {
     r.center = hull[0];
     return r;
   }
-  struct Candidate {
-    double ux, uy, u0, u1, v0, v1, area;
-  };
   // Every hull edge as a side (a segment: its own direction only).
   std::array<Candidate, 64> small{};
   std::vector<Candidate> large;
@@ -320,26 +670,35 @@ OrientedRect min_area_rect(std::span<const P2> pts, std::vector<P2>& hull, HullS
   }
   // Rectangles within 1 % of the least area are equally small (a right triangle's hull, the footprint of two
   // faces seen at a corner, has the same area on a leg and on the hypotenuse): of those, the one whose sides
-  // carry the most points, i.e. the faces the sensor saw. Ties keep the first (deterministic).
-  const Candidate* best = nullptr;
-  std::size_t best_score = 0;
-  std::size_t scored = 0;
+  // carry the most points, i.e. the faces the sensor saw. Ties keep the first (deterministic). Only the first
+  // four are scored (a circle-like hull ties everywhere: 4 suffice).
   const auto ties = [&](const Candidate& c) { return !(c.area > best_area * 1.01 + 1e-12); };
+  std::array<const Candidate*, 4> scored{};
+  std::size_t n_scored = 0, n_ties = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    if (!ties(cand[k])) continue;
+    ++n_ties;
+    if (n_scored < scored.size()) scored[n_scored++] = &cand[k];
+  }
+  const Candidate* best = n_scored > 0 ? scored[0] : nullptr;
   // One rectangle within 1 %: it wins whatever its score, so the points need not be counted.
-  const bool alone = std::count_if(cand, cand + count, ties) == 1;
-  for (std::size_t k = 0; k < count && scored < 4; ++k) {  // (a circle-like hull ties everywhere: 4 suffice)
-    const Candidate& c = cand[k];
-    if (!ties(c)) continue;
-    ++scored;
-    if (alone) {
-      best = &c;
-      break;
+  if (n_ties > 1) {
+    // Points counted by every scored rectangle add the same to each score: only those some may not count are
+    // looked at one by one, when the pre-filter vouched for the points (finite, float-safe).
+    std::span<const P2> looked = pts;
+    std::size_t common = 0;
+    if (seen.tame) {
+      maybe_uncounted(pts, {scored.data(), n_scored}, seen.reach, scratch.points);
+      looked = scratch.points;
+      common = pts.size() - looked.size();
     }
-    const double tol = std::max(0.05, 0.02 * std::max(c.u1 - c.u0, c.v1 - c.v0));
-    const std::size_t score = count_near_sides(pts, c.ux, c.uy, c.u0, c.u1, c.v0, c.v1, tol);
-    if (best == nullptr || score > best_score) {
-      best = &c;
-      best_score = score;
+    std::size_t best_score = 0;
+    for (std::size_t k = 0; k < n_scored; ++k) {
+      const std::size_t score = common + scored[k]->count(looked);
+      if (k == 0 || score > best_score) {
+        best = scored[k];
+        best_score = score;
+      }
     }
   }
   if (best == nullptr) {  // every hull edge of zero length: cannot happen after convex_hull, but be safe

@@ -31,8 +31,9 @@ struct HullScratch {
 };
 
 // Convex hull of `pts` counter-clockwise without collinear points, from the lowest-leftmost point (Andrew's
-// monotone chain; of over 64 points, those inside the Akl-Toussaint polygon of the extremes along 16
-// directions left out first; large sets sorted by radix).
+// monotone chain; of over 64 points, those inside the Akl-Toussaint octagon of the extremes along the axes and
+// diagonals, then inside that octagon refined by the farthest point beyond each edge, left out first (which
+// points are left out cannot change the hull); large sets sorted by radix).
 void convex_hull(std::span<const std::array<float, 2>> pts, std::vector<std::array<float, 2>>& hull,
                  HullScratch& scratch);
 
@@ -40,6 +41,8 @@ void convex_hull(std::span<const std::array<float, 2>> pts, std::vector<std::arr
 // zero at it; collinear points: width zero. Among rectangles within 1 % of the least area, the one whose sides
 // carry the most points (two faces seen at a corner make a right-triangle hull, whose leg- and
 // hypotenuse-aligned rectangles have the same area); remaining ties keep the first hull edge (deterministic).
+// Points no such rectangle can leave uncounted (most of a footprint: they lie on its faces) are counted once for
+// all of them.
 [[nodiscard]] OrientedRect min_area_rect(std::span<const std::array<float, 2>> pts,
                                          std::vector<std::array<float, 2>>& hull, HullScratch& scratch);
 
