@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -44,8 +45,6 @@ ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, floa
   const f32x4 vlo = simd::splat(lo), vhi = simd::splat(hi);
   const f32x4 zero = simd::splat(0.F);
   f32x4 n = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, syy = zero, sxz = zero, syz = zero;
-  const f32x4 big = simd::splat(std::numeric_limits<float>::max());
-  f32x4 x0 = big, x1 = -big, y0 = big, y1 = -big;
   for (std::size_t i = 0; i < pts_.padded; i += 4) {
     const f32x4 x = simd::load(pts_.x + i), y = simd::load(pts_.y + i), z = simd::load(pts_.z + i);
     const f32x4 r = z - (sa * x + sb * y + sc);
@@ -61,10 +60,6 @@ ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, floa
     syy += dy * dy;
     sxz += dx * dz;
     syz += dy * dz;
-    x0 = in ? (x < x0 ? x : x0) : x0;
-    x1 = in ? (x > x1 ? x : x1) : x1;
-    y0 = in ? (y < y0 ? y : y0) : y0;
-    y1 = in ? (y > y1 ? y : y1) : y1;
   }
   const auto sum = [](f32x4 v) {
     return static_cast<double>(v[0]) + static_cast<double>(v[1]) + static_cast<double>(v[2]) +
@@ -88,10 +83,45 @@ ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, floa
   f.mean_x = static_cast<float>(gx);
   f.mean_y = static_cast<float>(gy);
   f.count = static_cast<std::uint32_t>(cnt);
+  f.sel = sel;
+  f.lo = lo;
+  f.hi = hi;
+  return f;
+}
+
+// The diagonal of the x-y box of the points `f` was fitted to (the same selection again). Apart from
+// least_squares: of a bin's several fits only the last one's is looked at, and only for a bin that passed the
+// slope tests.
+float ZoneGround::spread(const Fit& f) const {
+  using simd::f32x4;
+  using simd::i32x4;
+  const f32x4 sa = simd::splat(f.sel.a), sb = simd::splat(f.sel.b), sc = simd::splat(f.sel.c);
+  const f32x4 vlo = simd::splat(f.lo), vhi = simd::splat(f.hi);
+  const f32x4 big = simd::splat(std::numeric_limits<float>::max());
+  f32x4 x0 = big, x1 = -big, y0 = big, y1 = -big;
+  for (std::size_t i = 0; i < pts_.padded; i += 4) {
+    const f32x4 x = simd::load(pts_.x + i), y = simd::load(pts_.y + i), z = simd::load(pts_.z + i);
+    const f32x4 r = z - (sa * x + sb * y + sc);
+    const i32x4 in = (r >= vlo) & (r < vhi);
+    x0 = in ? (x < x0 ? x : x0) : x0;
+    x1 = in ? (x > x1 ? x : x1) : x1;
+    y0 = in ? (y < y0 ? y : y0) : y0;
+    y1 = in ? (y > y1 ? y : y1) : y1;
+  }
   const float ex = std::max({x1[0], x1[1], x1[2], x1[3]}) - std::min({x0[0], x0[1], x0[2], x0[3]});
   const float ey = std::max({y1[0], y1[1], y1[2], y1[3]}) - std::min({y0[0], y0[1], y0[2], y0[3]});
-  f.spread = std::sqrt(ex * ex + ey * ey);
-  return f;
+  return std::sqrt(ex * ex + ey * ey);
+}
+
+// z - plane.z_at(x, y) for every point of pts_, padding included, into out (pts_.padded floats): four at a
+// time, lane by lane the scalar expression's operations in its order, so its bits.
+void ZoneGround::residuals(const GroundPlane& plane, float* out) const {
+  using simd::f32x4;
+  const f32x4 pa = simd::splat(plane.a), pb = simd::splat(plane.b), pc = simd::splat(plane.c);
+  for (std::size_t i = 0; i < pts_.padded; i += 4) {
+    const f32x4 r = simd::load(pts_.z + i) - (pa * simd::load(pts_.x + i) + pb * simd::load(pts_.y + i) + pc);
+    std::memcpy(out + i, &r, sizeof r);
+  }
 }
 
 // The points into sx_ .. sz_ by bin (input order within one, as a stable counting sort leaves them), each bin's
@@ -108,12 +138,14 @@ void ZoneGround::sort_into_bins(const Cloud& in) {
   sx_.resize(total);
   sy_.resize(total);
   sz_.resize(total);
+  sidx_.resize(total);
   cursor_.assign(bin_start_.begin(), bin_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t k = cursor_[bin_of_point_[i]]++;
     sx_[k] = in.x[i];
     sy_[k] = in.y[i];
     sz_[k] = in.z[i];
+    sidx_[k] = static_cast<std::uint32_t>(i);
   }
   for (std::size_t b = 0; b < nbins; ++b) {
     const std::uint32_t first = bin_start_[b];
@@ -179,8 +211,8 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
 
   // Seeds: the lowest points along the prior's slope.
   const GroundPlane slope{prior.plane.a, prior.plane.b, 0.F};
-  tmp_.resize(m);
-  for (std::size_t i = 0; i < m; ++i) tmp_[i] = pts_.z[i] - slope.z_at(pts_.x[i], pts_.y[i]);
+  tmp_.resize(pts_.padded);
+  residuals(slope, tmp_.data());  // the padding's too, past m: never looked at
   const std::size_t lowest = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(params_.seed_lowest, 1)), 1, m);
   std::nth_element(tmp_.begin(), tmp_.begin() + static_cast<std::ptrdiff_t>(lowest - 1), tmp_.end());
   float sum = 0.F;
@@ -221,7 +253,7 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   const float max_change = tan_max_change_;
   const float da = f.plane.a - prior.plane.a, db = f.plane.b - prior.plane.b;
   if (da * da + db * db > max_change * max_change) return;
-  if (f.spread < static_cast<float>(params_.min_spread_m)) return;
+  if (spread(f) < static_cast<float>(params_.min_spread_m)) return;
   const float step = f.plane.z_at(f.mean_x, f.mean_y) - prior.plane.z_at(f.mean_x, f.mean_y);
   const float ddx = f.mean_x - prior.ref_x, ddy = f.mean_y - prior.ref_y;
   const float dist = std::sqrt(ddx * ddx + ddy * ddy);
@@ -230,10 +262,15 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   // A ground plane is the lower envelope of its bin's returns. One with a return of its own bin far below it
   // was fitted to something standing there: behind a tree row only the near-horizontal lasers reach the next
   // row's crowns, and their returns make a flat, wide "ground" a metre up, with a lower laser's return under it.
+  // Four at a time over the padding too: a padding point is its run's first point a million metres up, so its
+  // residual is never below that point's (rounding is monotonic), and the answer is the same.
   if (params_.max_below_m > 0.0) {
-    const float deepest = -static_cast<float>(params_.max_below_m);
-    for (std::size_t i = 0; i < m; ++i) {
-      if (pts_.z[i] - f.plane.z_at(pts_.x[i], pts_.y[i]) < deepest) return;
+    using simd::f32x4;
+    const f32x4 deepest = simd::splat(-static_cast<float>(params_.max_below_m));
+    const f32x4 pa = simd::splat(f.plane.a), pb = simd::splat(f.plane.b), pc = simd::splat(f.plane.c);
+    for (std::size_t i = 0; i < pts_.padded; i += 4) {
+      const f32x4 r = simd::load(pts_.z + i) - (pa * simd::load(pts_.x + i) + pb * simd::load(pts_.y + i) + pc);
+      if (simd::mask_bits(r < deepest) != 0U) return;
     }
   }
   out.plane = f.plane;
@@ -298,10 +335,37 @@ void ZoneGround::interpolate_gaps() {
   for (std::size_t b = 0; b < bins_.size(); ++b) bins_[b].plane = filled_[b];
 }
 
+namespace {
+
+// hypot_f lane by lane: the squares summed and rooted in double, two lanes at a time, rounded to float (its
+// operations in its order, so its bits where it does not fall back; where it would, a lane is NaN here).
+inline simd::f32x4 hypot_f4(simd::f32x4 x, simd::f32x4 y) {
+#if defined(__SSE2__)
+  __m128 xv, yv;
+  std::memcpy(&xv, &x, sizeof xv);
+  std::memcpy(&yv, &y, sizeof yv);
+  const __m128d xl = _mm_cvtps_pd(xv), yl = _mm_cvtps_pd(yv);
+  const __m128d xh = _mm_cvtps_pd(_mm_movehl_ps(xv, xv)), yh = _mm_cvtps_pd(_mm_movehl_ps(yv, yv));
+  const __m128d rl = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(xl, xl), _mm_mul_pd(yl, yl)));
+  const __m128d rh = _mm_sqrt_pd(_mm_add_pd(_mm_mul_pd(xh, xh), _mm_mul_pd(yh, yh)));
+  const __m128 r = _mm_movelh_ps(_mm_cvtpd_ps(rl), _mm_cvtpd_ps(rh));
+  simd::f32x4 out;
+  std::memcpy(&out, &r, sizeof out);
+  return out;
+#else
+  return simd::f32x4{hypot_f(x[0], y[0]), hypot_f(x[1], y[1]), hypot_f(x[2], y[2]), hypot_f(x[3], y[3])};
+#endif
+}
+
+}  // namespace
+
 // Heights and labels. A point's ground, with blend_radial: between where its bin's plane was fitted and where the
 // plane of the bin beyond it on the point's side (outside it when the point lies farther out than that, else inside)
 // was fitted, the two planes interpolated by distance, as a ring's measured ground gives way to the next ring's. A
 // neighbour without a plane of its own does not count (its plane is a blend already).
+// Bin by bin over the sorted runs, four points at a time: a bin's own plane and its two neighbours' are the same
+// for all its points, and the results go back to each point's place in the cloud. Lane by lane the operations of
+// label_point, in its order (no contraction into fused multiply-adds on this target): the same bits.
 void ZoneGround::label(const Cloud& in, GroundLabels& out) {
   const auto guess = static_cast<float>(params_.max_extrapolation_m);
   label_.resize(bins_.size());
@@ -316,28 +380,98 @@ void ZoneGround::label(const Cloud& in, GroundLabels& out) {
                       fitted_or_none(inner_[b]),
                       bin.support_m > guess ? std::uint8_t{1} : std::uint8_t{0}};
   }
+  using simd::f32x4;
+  using simd::i32x4;
   const auto threshold = static_cast<float>(params_.ground_threshold_m);
   const bool blend = params_.blend_radial;
-  const std::size_t n = in.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Label& own = label_[bin_of_point_[i]];
-    const float x = in.x[i], y = in.y[i];
-    float g = own.plane.z_at(x, y);
-    if (blend) {
-      const std::uint32_t nb = x * x + y * y >= own.ref_r2 ? own.outer : own.inner;
-      if (nb != kNoBin) {
-        const Label& other = label_[nb];
-        const float d_own = hypot_f(x - own.ref_x, y - own.ref_y);
-        const float d_other = hypot_f(x - other.ref_x, y - other.ref_y);
-        const float sum = d_own + d_other;
-        if (sum > 0.F) g = (d_other * g + d_own * other.plane.z_at(x, y)) / sum;
+  const f32x4 zero = simd::splat(0.F);
+  const auto nbins = static_cast<std::uint32_t>(bins_.size());
+  float* const height = out.height_m.data();
+  std::uint8_t* const is_ground = out.ground.data();
+  std::uint8_t* const guessed = out.guessed.data();
+  for (std::uint32_t b = 0; b < nbins; ++b) {
+    const std::uint32_t first = bin_start_[b], count = bin_count_[b];
+    if (count == 0) continue;
+    const Label& own = label_[b];
+    const f32x4 pa = simd::splat(own.plane.a), pb = simd::splat(own.plane.b), pc = simd::splat(own.plane.c);
+    const f32x4 rx = simd::splat(own.ref_x), ry = simd::splat(own.ref_y), rr2 = simd::splat(own.ref_r2);
+    // The neighbour a point blends with: outer where it lies at least as far out as own.ref, else inner. A missing
+    // one stands in as own's plane and place, never taken (its lanes are masked off).
+    const bool has_outer = blend && own.outer != kNoBin, has_inner = blend && own.inner != kNoBin;
+    const Label& lo = has_outer ? label_[own.outer] : own;
+    const Label& li = has_inner ? label_[own.inner] : own;
+    const i32x4 outer_ok = simd::splat(has_outer ? std::int32_t{-1} : 0);
+    const i32x4 inner_ok = simd::splat(has_inner ? std::int32_t{-1} : 0);
+    const float* const xs = sx_.data() + first;
+    const float* const ys = sy_.data() + first;
+    const float* const zs = sz_.data() + first;
+    const std::uint32_t* const idx = sidx_.data() + first;
+    for (std::uint32_t k = 0; k < count; k += 4) {
+      const f32x4 x = simd::load(xs + k), y = simd::load(ys + k), z = simd::load(zs + k);
+      f32x4 g = pa * x + pb * y + pc;
+      if (has_outer || has_inner) {
+        const i32x4 outside = x * x + y * y >= rr2;
+        const i32x4 take_nb = outside ? outer_ok : inner_ok;
+        const f32x4 oa = outside ? simd::splat(lo.plane.a) : simd::splat(li.plane.a);
+        const f32x4 ob = outside ? simd::splat(lo.plane.b) : simd::splat(li.plane.b);
+        const f32x4 oc = outside ? simd::splat(lo.plane.c) : simd::splat(li.plane.c);
+        const f32x4 ox = outside ? simd::splat(lo.ref_x) : simd::splat(li.ref_x);
+        const f32x4 oy = outside ? simd::splat(lo.ref_y) : simd::splat(li.ref_y);
+        const f32x4 d_own = hypot_f4(x - rx, y - ry);
+        const f32x4 d_other = hypot_f4(x - ox, y - oy);
+        const f32x4 sum = d_own + d_other;
+        if (simd::mask_bits(sum != sum) != 0U) {  // NaN in either distance (neither is negative: no inf - inf)
+          // NaN somewhere (a non-finite point or plane): hypot_f's own fallback decides, point by point.
+          for (std::uint32_t l = 0; l < 4 && k + l < count; ++l) label_point(in, idx[k + l], out);
+          continue;
+        }
+        const f32x4 blended = (d_other * g + d_own * (oa * x + ob * y + oc)) / (sum > zero ? sum : simd::splat(1.F));
+        g = (take_nb & (sum > zero)) ? blended : g;
+      }
+      const f32x4 h = z - g;
+      const i32x4 ground = -(h < simd::splat(threshold));  // 1 or 0
+      const auto put = [&](std::uint32_t l) {
+        const std::uint32_t i = idx[k + l];
+        height[i] = h[l];
+        is_ground[i] = static_cast<std::uint8_t>(ground[l]);
+        guessed[i] = own.guessed;
+      };
+      if (count - k >= 4) {
+        put(0);
+        put(1);
+        put(2);
+        put(3);
+      } else {
+        for (std::uint32_t l = 0; l < count - k; ++l) put(l);
       }
     }
-    const float h = in.z[i] - g;
-    out.height_m[i] = h;
-    out.ground[i] = h < threshold ? 1U : 0U;
-    out.guessed[i] = own.guessed;
   }
+}
+
+// One point's height and labels, as label() gives them four at a time.
+void ZoneGround::label_point(const Cloud& in, std::uint32_t i, GroundLabels& out) const {
+  const Label& own = label_[bin_of_point_[i]];
+  const float x = in.x[i], y = in.y[i];
+  float g = own.plane.z_at(x, y);
+  if (params_.blend_radial) {
+    const std::uint32_t nb = x * x + y * y >= own.ref_r2 ? own.outer : own.inner;
+    if (nb != kNoBin) {
+      const Label& other = label_[nb];
+      const float d_own = hypot_f(x - own.ref_x, y - own.ref_y);
+      const float d_other = hypot_f(x - other.ref_x, y - other.ref_y);
+      const float sum = d_own + d_other;
+      if (sum > 0.F) g = (d_other * g + d_own * other.plane.z_at(x, y)) / sum;
+    }
+  }
+  const float h = in.z[i] - g;
+  out.height_m[i] = h;
+  out.ground[i] = h < static_cast<float>(params_.ground_threshold_m) ? 1U : 0U;
+  out.guessed[i] = own.guessed;
+}
+
+void ZoneGround::label_one_at_a_time(const Cloud& in, GroundLabels& out) const {
+  out.resize(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) label_point(in, static_cast<std::uint32_t>(i), out);
 }
 
 void ZoneGround::segment(const Cloud& in, GroundLabels& out) {

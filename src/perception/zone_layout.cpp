@@ -127,27 +127,25 @@ void ZoneGround::bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const {
   using simd::i32x4;
   const std::size_t n = in.size();
   out.resize(n);
-  // Each zone's constants, one lane each, chosen per lane by how many zone ends the range has passed (the ends
-  // increase, so passing one passes all before it: bin_of_polar's count). NaN passes none: the first zone, as there.
-  struct Lanes {
-    f32x4 r0, inv_ring_width, max_ring, sector_scale, max_sector;
-    i32x4 first_bin, sectors;
+  // Each zone's constants in two rows of four, to be picked per lane by how many zone ends the range has passed (the
+  // ends increase, so passing one passes all before it: bin_of_polar's count; NaN passes none, the first zone, as
+  // there). The points come in scan order, one firing's lasers near and far, so the four lanes are mostly in
+  // different zones: each lane's two rows are loaded and transposed into one vector per constant.
+  struct Rows {
+    f32x4 lo;  // r0, inv_ring_width, max_ring, sector_scale
+    f32x4 hi;  // max_sector, first_bin and sectors (their bits), unused
   };
-  const auto lanes_of = [](const Zone& z) {
-    return Lanes{simd::splat(z.r0),
-                 simd::splat(z.inv_ring_width),
-                 simd::splat(z.max_ring),
-                 simd::splat(z.sector_scale),
-                 simd::splat(z.max_sector),
-                 simd::splat(static_cast<std::int32_t>(z.first_bin)),
-                 simd::splat(static_cast<std::int32_t>(z.sectors))};
-  };
-  // Splatted once per call, not per step: the selects below read them from memory (they are more than the vector
-  // registers). ends[k]: where zone k + 1 begins.
-  std::vector<Lanes> lanes;
-  std::vector<f32x4> ends;
-  for (const Zone& z : zones_) lanes.push_back(lanes_of(z));
+  std::vector<Rows> rows;
+  for (const Zone& z : zones_) {
+    const i32x4 ints = {0, static_cast<std::int32_t>(z.first_bin), static_cast<std::int32_t>(z.sectors), 0};
+    Rows r{{z.r0, z.inv_ring_width, z.max_ring, z.sector_scale}, {}};
+    std::memcpy(&r.hi, &ints, sizeof ints);
+    r.hi[0] = z.max_sector;
+    rows.push_back(r);
+  }
+  std::vector<f32x4> ends;  // ends[k]: where zone k + 1 begins
   for (std::size_t k = 1; k < zones_.size(); ++k) ends.push_back(simd::splat(zones_[k - 1].r1));
+  const Rows* const row = rows.data();
   const f32x4 zero = simd::splat(0.F), pi = simd::splat(std::numbers::pi_v<float>);
   std::size_t p = 0;
   for (; p + 4 <= n; p += 4) {
@@ -159,25 +157,23 @@ void ZoneGround::bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const {
     const f32x4 r = {std::sqrt(r2[0]), std::sqrt(r2[1]), std::sqrt(r2[2]), std::sqrt(r2[3])};
 #endif
     const f32x4 theta = fast_atan2(y, x);
-    Lanes z = lanes[0];
-    for (std::size_t k = 1; k < lanes.size(); ++k) {
-      const i32x4 past = r >= ends[k - 1];
-      const Lanes& o = lanes[k];
-      z.r0 = past ? o.r0 : z.r0;
-      z.inv_ring_width = past ? o.inv_ring_width : z.inv_ring_width;
-      z.max_ring = past ? o.max_ring : z.max_ring;
-      z.sector_scale = past ? o.sector_scale : z.sector_scale;
-      z.max_sector = past ? o.max_sector : z.max_sector;
-      z.first_bin = past ? o.first_bin : z.first_bin;
-      z.sectors = past ? o.sectors : z.sectors;
-    }
-    f32x4 rf = (r - z.r0) * z.inv_ring_width;
+    i32x4 passed = simd::splat(0);
+    for (const f32x4& end : ends) passed -= r >= end;
+    const Rows &z0 = row[passed[0]], &z1 = row[passed[1]], &z2 = row[passed[2]], &z3 = row[passed[3]];
+    f32x4 r0 = z0.lo, inv_ring_width = z1.lo, max_ring = z2.lo, sector_scale = z3.lo;
+    simd::transpose4(r0, inv_ring_width, max_ring, sector_scale);
+    f32x4 max_sector = z0.hi, first_bits = z1.hi, sectors_bits = z2.hi, unused = z3.hi;
+    simd::transpose4(max_sector, first_bits, sectors_bits, unused);
+    i32x4 first_bin, sectors;
+    std::memcpy(&first_bin, &first_bits, sizeof first_bin);
+    std::memcpy(&sectors, &sectors_bits, sizeof sectors);
+    f32x4 rf = (r - r0) * inv_ring_width;
     rf = rf > zero ? rf : zero;
-    rf = rf < z.max_ring ? rf : z.max_ring;
-    f32x4 sf = (theta + pi) * z.sector_scale;
+    rf = rf < max_ring ? rf : max_ring;
+    f32x4 sf = (theta + pi) * sector_scale;
     sf = sf > zero ? sf : zero;
-    sf = sf < z.max_sector ? sf : z.max_sector;
-    const i32x4 b = z.first_bin + __builtin_convertvector(rf, i32x4) * z.sectors + __builtin_convertvector(sf, i32x4);
+    sf = sf < max_sector ? sf : max_sector;
+    const i32x4 b = first_bin + __builtin_convertvector(rf, i32x4) * sectors + __builtin_convertvector(sf, i32x4);
     std::memcpy(out.data() + p, &b, sizeof b);
   }
   for (; p < n; ++p) out[p] = bin_of(in.x[p], in.y[p]);

@@ -351,6 +351,90 @@ TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
   }
 }
 
+// bins_of takes a zone's constants whole where all four points of a step lie in that zone (runs of near points,
+// as a voxel grid gives them), and per point otherwise: runs of four on each side of every zone edge, runs that
+// straddle one, and one point off in a run, must all give bin_of's bins.
+TEST(ZoneGround, BinsRunsOfFourInOneZoneAsOneAtATime) {
+  ZoneParams p;
+  p.edges_m = {2.0, 6.0, 14.0, 26.0, 50.0};
+  p.rings = {2, 4, 4, 4};
+  p.sectors = {16, 32, 48, 64};
+  const ZoneGround zones(p);
+  Cloud c;
+  testing::TestRng rng(5);
+  const auto at = [&c](float r, float a) { c.push_back(r * std::cos(a), r * std::sin(a), 0.F); };
+  for (const double e : p.edges_m) {
+    const auto edge = static_cast<float>(e);
+    for (const float off : {-0.3F, -1e-6F, 0.F, 1e-6F, 0.3F}) {
+      const float a = rng.uniform(-3.14F, 3.14F);
+      for (int k = 0; k < 4; ++k) at(edge + off, a + 0.01F * static_cast<float>(k));  // one run, one side
+    }
+    at(edge - 0.01F, 1.F);  // a run across the edge: two in, two out
+    at(edge - 0.01F, 1.F);
+    at(edge + 0.01F, 1.F);
+    at(edge + 0.01F, 1.F);
+  }
+  for (int run = 0; run < 2000; ++run) {  // runs of near points, now and then one far
+    const float r = rng.uniform(0.F, 60.F), a = rng.uniform(-3.2F, 3.2F);
+    const int odd = run % 7 == 0 ? run % 4 : -1;
+    for (int k = 0; k < 4; ++k) at(k == odd ? rng.uniform(0.F, 60.F) : r + 0.05F * static_cast<float>(k), a);
+  }
+  Buffer<std::uint32_t> bins;
+  zones.bins_of(c, bins);
+  ASSERT_EQ(bins.size(), c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    ASSERT_EQ(bins[i], zones.bin_of(c.x[i], c.y[i])) << "point " << i << " at " << c.x[i] << ", " << c.y[i];
+  }
+}
+
+// segment() labels bin by bin, four points at a time (bins of every size, so every tail), blending with the
+// neighbour outside or inside per point; the labels must be label_one_at_a_time's to the bit, with and without
+// blend_radial, and also with points that are not finite (a step with a NaN distance falls back to the
+// one-at-a-time arithmetic; such points leave the planes NaN, but the two must still agree).
+TEST(ZoneGround, LabelsFourAtATimeAsOneAtATime) {
+  sim::Scene scene;
+  scene.terrain.undulation_m = 0.4;
+  scene.terrain.ridge_x_m = 21.0;
+  scene.terrain.ridge_width_m = 5.0;
+  scene.terrain.ridge_height_m = 1.0;
+  scene.cylinders.push_back(sim::Cylinder{12.0, 1.5, 0.3, 1.8, 0.0});
+  Cloud c = prepared(scene, 5.0);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  Cloud odd = c;  // and points no crop lets through: not finite
+  odd.push_back(nan, 3.F, -0.9F);
+  odd.push_back(20.F, inf, -0.9F);
+  odd.push_back(inf, -inf, 0.F);
+  odd.push_back(8.F, 1.F, nan);
+  const auto same = [](float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0 || (a != a && b != b); };
+  for (const Cloud* cloud : {&c, &odd}) {
+    for (const bool blend : {true, false}) {
+      ZoneParams zp;
+      zp.blend_radial = blend;
+      zp.max_below_m = 0.3;
+      ZoneGround zones(zp);
+      GroundLabels four, one;
+      zones.segment(*cloud, four);
+      zones.label_one_at_a_time(*cloud, one);
+      ASSERT_EQ(four.height_m.size(), cloud->size());
+      std::size_t blended = 0;
+      for (std::size_t i = 0; i < cloud->size(); ++i) {
+        ASSERT_TRUE(same(four.height_m[i], one.height_m[i]))
+            << "point " << i << ": " << four.height_m[i] << " vs " << one.height_m[i];
+        ASSERT_EQ(four.ground[i], one.ground[i]) << i;
+        ASSERT_EQ(four.guessed[i], one.guessed[i]) << i;
+        const float own = cloud->z[i] - zones.ground_z(cloud->x[i], cloud->y[i]);
+        blended += same(own, four.height_m[i]) ? 0U : 1U;
+      }
+      if (cloud == &odd) continue;  // a NaN point in the innermost ring leaves every plane NaN: nothing to count
+      if (blend) {
+        EXPECT_GT(blended, cloud->size() / 4);  // the blend path was taken
+      } else {
+        EXPECT_EQ(blended, 0U);
+      }
+    }
+  }
+}
+
 // The ground's distances go through hypot_f: it must give std::hypot's bits, or heights (and obstacles) change.
 TEST(ZoneGround, HypotGivesTheLibrarysBits) {
   testing::TestRng rng(11);

@@ -55,6 +55,9 @@ class ZoneGround {
   // bin_of for every point of `in` into `out` (resized): four at a time, the same arithmetic lane by lane, so the
   // same bins.
   void bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const;
+  // After segment(in, ...): the labels again, one point at a time in cloud order (segment() works bin by bin, four
+  // points at a time, with the same arithmetic lane by lane: the same bits). For tests.
+  void label_one_at_a_time(const Cloud& in, GroundLabels& out) const;
 
  private:
   struct Zone {
@@ -75,17 +78,21 @@ class ZoneGround {
     GroundPlane plane;
     float mean_x = 0.F, mean_y = 0.F;
     std::uint32_t count = 0;
-    float spread = 0.F;
+    GroundPlane sel;  // fitted to the points whose residual to sel lies in [lo, hi)
+    float lo = 0.F, hi = 0.F;
   };
 
   GroundPlane fit_innermost();
   void fit_bin(std::uint32_t bin, const Bin& prior);
   [[nodiscard]] Fit least_squares(const GroundPlane& sel, float lo, float hi, const GroundPlane& prior,
                                   double prior_per_point) const;
+  [[nodiscard]] float spread(const Fit& f) const;
+  void residuals(const GroundPlane& plane, float* out) const;
   void sort_into_bins(const Cloud& in);
   void gather_innermost(std::uint32_t b0, std::uint32_t b1);
   void interpolate_gaps();
   void label(const Cloud& in, GroundLabels& out);
+  void label_point(const Cloud& in, std::uint32_t i, GroundLabels& out) const;
 
   ZoneParams params_;
   std::vector<Zone> zones_;
@@ -113,6 +120,7 @@ class ZoneGround {
   Buffer<std::uint32_t> bin_start_;  // per bin (and one past the last): where its run starts in sx_ .. sz_
   Buffer<std::uint32_t> cursor_;
   Buffer<float> sx_, sy_, sz_;
+  Buffer<std::uint32_t> sidx_;  // per sorted point: its index in the cloud (padding: unset)
   Buffer<float> bx_, by_, bz_, tmp_;  // the innermost ring's points (padded), and scratch
   // The points least_squares and fit_bin look at: one bin's run, or the innermost ring's.
   struct Points {
