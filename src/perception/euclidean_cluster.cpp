@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
@@ -23,6 +24,8 @@ constexpr float kSlack = 1e-3F;
 inline float grow(float t, float growth, float cap, float range_m) {
   return std::min(cap, std::max(t, growth * range_m));
 }
+
+using u32x4 = std::uint32_t __attribute__((vector_size(16)));
 
 // Union-find over cells: the root of `c`, halving the path on the way.
 inline std::uint32_t find_root(std::uint32_t* parent, std::uint32_t c) {
@@ -317,14 +320,72 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   z_start_.assign(std::size_t{nz_top} + 2, 0U);
   cell_of_.resize(n);  // column of each point
   z_of_.resize(n);     // z cell of each point
-  for (std::size_t i = 0; i < n; ++i) {
+  const RadiusModel rm = radius_model();
+  if (adaptive_) {  // and its radii (squared) and 3D range, for the cells below
+    r2_.resize(n);
+    h2_.resize(n);
+    range_.resize(n);
+  }
+  std::size_t i4 = 0;
+  {
+    // Four points at a time: lane by lane the operations of the scalar loop below, in its order (cell, RadiusModel
+    // and std::sqrt), so the same cells and radii to the bit. Every value is finite here, and a cell index is below
+    // max_cols, far from the top bit: the conversions and the unsigned minimum see nothing out of range.
+    using simd::f32x4;
+    const f32x4 vinv = simd::splat(inv), lx = simd::splat(lo[0]), ly = simd::splat(lo[1]), lz = simd::splat(lo[2]);
+    const auto top_x = static_cast<std::uint32_t>(nx - 1), top_y = static_cast<std::uint32_t>(ny - 1);
+    const u32x4 vtop_x = {top_x, top_x, top_x, top_x}, vtop_y = {top_y, top_y, top_y, top_y};
+    const u32x4 vtop_z = {nz_top, nz_top, nz_top, nz_top};
+    const auto ny32 = static_cast<std::uint32_t>(ny);
+    const u32x4 vny = {ny32, ny32, ny32, ny32};
+    const auto cells = [&](f32x4 v, f32x4 origin, u32x4 top) {
+      const auto c = __builtin_convertvector(__builtin_convertvector((v - origin) * vinv, simd::i32x4), u32x4);
+      return c < top ? c : top;
+    };
+    const f32x4 vt = simd::splat(rm.t), base_r2 = simd::splat(rm.base_r2);
+    const f32x4 gv = simd::splat(rm.gv), cap_v = simd::splat(rm.cap_v), gh = simd::splat(rm.gh);
+    const f32x4 cap_h = simd::splat(rm.cap_h);
+    const auto grow4 = [&](f32x4 g, f32x4 cap, f32x4 range) {
+      const f32x4 gr = g * range;
+      const f32x4 m = vt < gr ? gr : vt;  // std::max(t, g * range)
+      return m < cap ? m : cap;         // std::min(cap, that)
+    };
+    const auto squared4 = [&](f32x4 radius) { return radius == vt ? base_r2 : radius * radius; };
+    for (; i4 + 4 <= n; i4 += 4) {
+      const f32x4 x = simd::load(in.x.data() + i4), y = simd::load(in.y.data() + i4), z = simd::load(in.z.data() + i4);
+      const u32x4 c = cells(x, lx, vtop_x) * vny + cells(y, ly, vtop_y);
+      const u32x4 iz = cells(z, lz, vtop_z);
+      std::memcpy(cell_of_.data() + i4, &c, sizeof c);
+      std::memcpy(z_of_.data() + i4, &iz, sizeof iz);
+      if (!adaptive_) continue;
+      const f32x4 sq = x * x + y * y + z * z;
+#if defined(__SSE2__)
+      const f32x4 range = _mm_sqrt_ps(sq);  // correctly rounded, as std::sqrt
+#else
+      const f32x4 range = {std::sqrt(sq[0]), std::sqrt(sq[1]), std::sqrt(sq[2]), std::sqrt(sq[3])};
+#endif
+      const f32x4 v = grow4(gv, cap_v, range);
+      const f32x4 v2 = squared4(v);
+      const f32x4 hv2 = rm.aniso ? squared4(grow4(gh, cap_h, range)) : v2;
+      std::memcpy(range_.data() + i4, &range, sizeof range);
+      std::memcpy(r2_.data() + i4, &v2, sizeof v2);
+      std::memcpy(h2_.data() + i4, &hv2, sizeof hv2);
+    }
+  }
+  for (std::size_t i = i4; i < n; ++i) {
     const std::size_t c = std::min<std::size_t>(cell(in.x[i], lo[0]), nx - 1) * ny +
                           std::min<std::size_t>(cell(in.y[i], lo[1]), ny - 1);
-    const std::uint32_t z = std::min(cell(in.z[i], lo[2]), nz_top);
     cell_of_[i] = static_cast<std::uint32_t>(c);
-    z_of_[i] = z;
-    ++col_start_[c + 2];
-    ++z_start_[z + 1];
+    z_of_[i] = std::min(cell(in.z[i], lo[2]), nz_top);
+    if (!adaptive_) continue;
+    const float x = in.x[i], y = in.y[i], z = in.z[i];
+    range_[i] = std::sqrt(x * x + y * y + z * z);
+    r2_[i] = rm.squared(rm.v(range_[i]));
+    h2_[i] = rm.squared(rm.h(range_[i]));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    ++col_start_[std::size_t{cell_of_[i]} + 2];
+    ++z_start_[std::size_t{z_of_[i]} + 1];
   }
   for (std::size_t c = 2; c < cols + 2; ++c) col_start_[c] += col_start_[c - 1];
   for (std::size_t z = 1; z <= nz_top; ++z) z_start_[z] += z_start_[z - 1];
@@ -340,7 +401,6 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   // order (coordinates and radii, one array each, padded by four: the pair test reads four at a time) and makes
   // their cells with their point boxes and largest radii.
   const double e = static_cast<double>(edge), rho2 = 2.0 * static_cast<double>(rounding);
-  const RadiusModel rm = radius_model();
   const auto stack_of = [&](std::size_t c) -> std::uint32_t {
     if (!adaptive_) return 1;
     const double x0 = static_cast<double>(lo[0]) + static_cast<double>(c / ny) * e - rho2;
@@ -362,14 +422,26 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   float* const r2 = sz + n + 4;  // vertical radius squared (the only one unless anisotropic)
   float* const h2 = anisotropic_ ? r2 + n + 4 : r2;
   cells_.resize(n + 1);  // at most a cell a point, and the end sentinel
-  cell_z_.resize(n);
+  cell_z_.resize(n + 4);  // and room for the row scan's four-wide reads past the last cell (see below)
   cell_box_.resize(6 * n);
   col_cells_.resize(cols + 1);
   Cell* const cl = cells_.data();
   ZSpan* const zspan = cell_z_.data();
   float* const boxes = cell_box_.data();
+  pos_of_.resize(n);  // the cell of each point (by cloud index), and at the end its root cell
   std::uint32_t ncells = 0;
   for (std::size_t c = 0; c < cols; ++c) {
+    // Most columns are empty: four at a time where all four are (their starts all equal the next one's).
+    while (c + 5 <= cols + 1) {
+      u32x4 starts, nexts;
+      std::memcpy(&starts, col_start_.data() + c, sizeof starts);
+      std::memcpy(&nexts, col_start_.data() + c + 1, sizeof nexts);
+      if (simd::mask_bits(starts == nexts) != 0xFU) break;
+      const u32x4 here = {ncells, ncells, ncells, ncells};
+      std::memcpy(col_cells_.data() + c, &here, sizeof here);
+      c += 4;
+    }
+    if (c == cols) break;
     col_cells_[c] = ncells;
     const std::uint32_t b = col_start_[c], end = col_start_[c + 1];
     if (b == end) continue;
@@ -385,9 +457,9 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
       sz[j] = z;
       float range = 0.F, v2 = base_r2_, hv2 = base_r2_;
       if (adaptive_) {
-        range = std::sqrt(x * x + y * y + z * z);
-        v2 = rm.squared(rm.v(range));
-        hv2 = rm.squared(rm.h(range));
+        range = range_[i];
+        v2 = r2_[i];
+        hv2 = h2_[i];
       }
       r2[j] = v2;
       h2[j] = hv2;
@@ -401,9 +473,10 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
         box[0] = box[3] = x;
         box[1] = box[4] = y;
         box[2] = box[5] = z;
-        ++ncells;
+        pos_of_[i] = ncells++;
         continue;
       }
+      pos_of_[i] = ncells - 1;
       box[0] = std::min(box[0], x);
       box[1] = std::min(box[1], y);
       box[2] = std::min(box[2], z);
@@ -426,9 +499,13 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   // within D = max(its own radii, min(cap, g R / (1 - g))) (as the k-d tree's search radius, see prepare), so
   // the pair's radii are at most those at R + D, R the cell's farthest point. The box pretest and the point
   // test then take each pair's own radii. Dense surfaces join early and most pairs end at the union-find check.
-  parent_.resize(ncells);
+  parent_.resize(ncells + 4);
   std::uint32_t* const parent = parent_.data();
   for (std::uint32_t c = 0; c < ncells; ++c) parent[c] = c;
+  for (std::uint32_t c = ncells; c < ncells + 4; ++c) {  // read by the row scan, never taken: lanes past its end
+    parent[c] = c;
+    zspan[c] = ZSpan{0, 0};
+  }
   const bool aniso = anisotropic_;
   const float gq = anisotropic_ ? std::max(growth_, growth_h_) : growth_;
   const float capq = anisotropic_ ? std::max(cap_, cap_h_) : cap_;
@@ -460,6 +537,10 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     // Forced inline: three loops call it, and as a call (what g++ chose) the stage took 18% more instructions.
     const auto visit = [&](std::uint32_t b) __attribute__((always_inline)) {
       if (zs[b].iz > z_hi || zs[b].iz_top < z_lo) return;
+      // Most cells that get here are in a's cluster already, many of them pointing straight at its root (ra is a
+      // root throughout): that ends here without the walk. (Skipping the walk's path halving changes which
+      // ancestor a cell points at, never its root: the clusters are the same.)
+      if (parent[b] == ra) return;
       const std::uint32_t rb = find_root(parent, b);
       if (ra == rb) return;
       // The gap between the two cells' point boxes on each axis, taken short by kSlack: no two of their points
@@ -483,30 +564,62 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     };
     const std::uint32_t own = col_cells_[ca.col];  // a's column: ascending in z, so below z_lo it is done
     for (std::uint32_t b = a; b > own && zs[b - 1].iz_top >= z_lo;) visit(--b);
-    for (std::uint32_t b = own, first = col_cells_[std::size_t{ax} * ny + y0]; b > first;) visit(--b);
-    for (std::uint32_t x = ax > hreach ? ax - hreach : 0U; x < ax; ++x) {
+    // The rest: runs of cells, most of them out of a's z range or in its cluster already. Four at a time those are
+    // passed over (a cell whose parent was ra when looked at is in a's cluster for good: joins only ever point a
+    // root at another), and the others visited in the scalar order. candidates(b): which of cells b .. b + 3 to
+    // visit (every read stays inside the arrays: they have four cells' room past the last).
+    static_assert(sizeof(ZSpan) == 2 * sizeof(std::uint32_t));  // two cells' spans to a vector
+    const u32x4 vz_lo = {z_lo, z_lo, z_lo, z_lo}, vz_hi = {z_hi, z_hi, z_hi, z_hi};
+    const auto candidates = [&](std::uint32_t b) __attribute__((always_inline)) {
+      u32x4 s01, s23, up;
+      std::memcpy(&s01, zs + b, sizeof s01);
+      std::memcpy(&s23, zs + b + 2, sizeof s23);
+      std::memcpy(&up, parent + b, sizeof up);
+      const u32x4 iz = __builtin_shufflevector(s01, s23, 0, 2, 4, 6);
+      const u32x4 iz_top = __builtin_shufflevector(s01, s23, 1, 3, 5, 7);
+      const u32x4 vra = {ra, ra, ra, ra};
+      return simd::mask_bits((iz <= vz_hi) & (iz_top >= vz_lo) & (up != vra));
+    };
+    {  // a's row, the columns before a's: backwards from a's column, nearest first
+      const std::uint32_t first = col_cells_[std::size_t{ax} * ny + y0];
+      std::uint32_t b = own;  // cells [first, b) left
+      for (; b >= first + 4; b -= 4) {
+        for (unsigned todo = candidates(b - 4); todo != 0U;) {
+          const auto l = static_cast<std::uint32_t>(31 - __builtin_clz(todo));
+          visit(b - 4 + l);
+          todo &= ~(1U << l);
+        }
+      }
+      while (b > first) visit(--b);
+    }
+    for (std::uint32_t x = ax > hreach ? ax - hreach : 0U; x < ax; ++x) {  // the rows before, in order
       const std::size_t row = std::size_t{x} * ny;
-      for (std::uint32_t b = col_cells_[row + y0], last = col_cells_[row + y1 + 1]; b < last; ++b) visit(b);
+      const std::uint32_t last = col_cells_[row + y1 + 1];
+      for (std::uint32_t b = col_cells_[row + y0]; b < last; b += 4) {
+        // The row's cells only: lane l where b + l < last.
+        const unsigned lanes = 0xFU >> (4U - std::min(4U, last - b));
+        for (unsigned todo = candidates(b) & lanes; todo != 0U; todo &= todo - 1U) {
+          visit(b + static_cast<std::uint32_t>(__builtin_ctz(todo)));
+        }
+      }
     }
   }
 
   // Clusters in the order of their lowest point index, members ascending. A cell's parent is never after it
   // (a join points the later root at the earlier one, and path halving at an ancestor), so one pass in cell
   // order points every cell at its root and adds its size to the root's. Then one pass over the points in
-  // index order: a root first met opens the next cluster (its offset known from the size), and each point goes
-  // to its root's next slot.
+  // index order: a root first met (the root of the point's cell) opens the next cluster (its offset known from
+  // the size), and each point goes to its root's next slot.
   root_size_.assign(ncells, 0U);
-  pos_of_.resize(n);  // root cell of each point
   for (std::uint32_t c = 0; c < ncells; ++c) {
     parent[c] = parent[parent[c]];
     root_size_[parent[c]] += cl[c + 1].first - cl[c].first;
-    for (std::uint32_t j = cl[c].first; j < cl[c + 1].first; ++j) pos_of_[grid_index_[j]] = parent[c];
   }
   cluster_of_root_.assign(ncells, kNoCluster);  // then the root's next slot in out.indices
   out.indices.resize(n);
   std::uint32_t opened = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t r = pos_of_[i];
+    const std::uint32_t r = parent[pos_of_[i]];
     std::uint32_t& slot = cluster_of_root_[r];
     if (slot == kNoCluster) {
       slot = opened;

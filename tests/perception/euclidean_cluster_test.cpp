@@ -349,6 +349,42 @@ TEST(EuclideanClusterer, AnisotropicKdTreeAndGridAgree) {
   EXPECT_EQ(sets_of(a), sets_of(b));
 }
 
+// The grid works four at a time in places: the points' cells and radii (the last n % 4 one at a time), empty
+// columns, and the runs of cells a cell looks back over (a run's last group reads past its end, masked). Clouds of
+// 1 to 13 points, and sparse rows of small clumps (many empty columns, runs of one to three cells), must give the
+// k-d tree's clusters, for every radius model.
+TEST(EuclideanClusterer, GridTailsAndShortRunsMatchTheKdTree) {
+  testing::TestRng rng{33};
+  std::vector<Cloud> clouds;
+  for (int n = 1; n <= 13; ++n) {
+    Cloud c;
+    for (int i = 0; i < n; ++i) c.push_back(rng.uniform(3, 6), rng.uniform(-1, 1), rng.uniform(-0.5F, 0.5F));
+    clouds.push_back(c);
+  }
+  for (int k = 0; k < 3; ++k) {
+    Cloud c;
+    for (int clump = 0; clump < 150; ++clump) {
+      const float x = rng.uniform(-8, 45), y = rng.uniform(-8, 8), z = rng.uniform(-1, 3);
+      const int m = 1 + clump % (k + 3);
+      for (int i = 0; i < m; ++i) {
+        c.push_back(x + rng.uniform(-0.3F, 0.3F), y + rng.uniform(-0.3F, 0.3F), z + rng.uniform(-0.6F, 0.6F));
+      }
+    }
+    clouds.push_back(c);
+  }
+  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
+    for (const Cloud& c : clouds) {
+      Clusters a, b;
+      EuclideanClusterer kd(params(method, ClusterStructure::KdTree, 0.4));
+      EuclideanClusterer grid(params(method, ClusterStructure::Grid, 0.4));
+      kd.extract(c, a);
+      grid.extract(c, b);
+      ASSERT_EQ(sets_of(a), sets_of(b)) << method_name(method) << ", " << c.size() << " points";
+      ASSERT_EQ(b.indices.size(), c.size());
+    }
+  }
+}
+
 // Far out the grid stacks z cells into taller ones (the radii are large there): two vertical runs of points
 // 30 m out join across a gap just under the vertical radius and stay apart across one just over it, and dense
 // far clouds give the k-d tree's clusters, for both growing radii.

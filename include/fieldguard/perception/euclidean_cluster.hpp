@@ -91,9 +91,10 @@ class EuclideanClusterer {
   Buffer<float> r2_;     // per point (adaptive): its radius squared
   Buffer<float> h2_;     // per point (anisotropic): its horizontal radius squared
   Buffer<float> query_;  // per point: the search radius that finds every neighbour
+  Buffer<float> range_;  // per point (grid, adaptive): its 3D range
   Buffer<std::uint8_t> done_;
   Buffer<std::uint32_t> queue_;
-  Buffer<std::uint32_t> pos_of_;  // cloud index -> position in the structure's order
+  Buffer<std::uint32_t> pos_of_;  // cloud index -> position in the structure's order (grid: its cell)
   // Grid (extract_grid), reused across frames.
   Buffer<std::uint32_t> col_start_;   // per x-y column: its first point in grid order
   Buffer<std::uint32_t> z_start_;     // per z cell: its first point in z order
