@@ -5,18 +5,19 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <utility>
 
 #include "perception/simd.hpp"
 
 namespace fieldguard::perception {
 namespace {
 
-// Voxel coordinates are packed in 20 bits each (offset by 2^19), the range band in the top 4 bits, so no key
-// is all ones: that marks an empty ring-cache entry.
+// Voxel coordinates are packed in 20 bits each (offset by 2^19), the range band (1-based) in the top 4 bits
+// (coarse_key(); block_keys() packs differently). kNoKey, which marks an empty ring-cache entry, is neither.
 constexpr std::int32_t kCoordOffset = 1 << 19;
 constexpr float kCoordLimit = 524287.0F;  // 2^19 - 1: coordinates beyond are clamped (5 km at a 1 cm leaf)
 constexpr std::uint32_t kMaxBands = 15;
-constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+constexpr std::uint64_t kNoKey = std::uint64_t{1} << 59U;  // high half 2^27: see block_keys()
 
 // floor() to int for the voxel index, as pcl::VoxelGrid's static_cast<int>(std::floor(x * inverse_leaf)),
 // without the libm call; NaN maps to the lower bound.
@@ -34,6 +35,14 @@ inline std::uint64_t pack(std::int32_t ix, std::int32_t iy, std::int32_t iz, std
 
 constexpr std::size_t kBlock = 16;  // points whose keys are computed together
 
+// f(0), f(1), ..., f(N - 1) for std::make_index_sequence<N>, unrolled: g++ -O2 does not unroll the block's
+// short loops, whose counters and indexing were about 2 of the ~45 instructions of a point (callgrind,
+// BM_Voxel "shed 5Hz").
+template <typename F, std::size_t... I>
+__attribute__((always_inline)) inline void unrolled(F&& f, std::index_sequence<I...> /*steps*/) {
+  (f(I), ...);
+}
+
 // The constants of block_keys(), splatted once per frame rather than once per block.
 struct KeyLanes {
   simd::f32x4 inv_leaf, lo, hi;
@@ -41,20 +50,24 @@ struct KeyLanes {
 };
 
 // Keys of kBlock points with one leaf, four at a time, clamped to the key's range.
-inline void block_keys(const float* x, const float* y, const float* z, const KeyLanes& c, std::uint64_t* keys) {
-  for (std::size_t b = 0; b < kBlock; b += 4) {
+// Inlined: as a call, each block reloaded the lanes' constants.
+__attribute__((always_inline)) inline void block_keys(const float* x, const float* y, const float* z, const KeyLanes& c,
+                                                      std::uint64_t* keys) {
+  const auto four = [&](std::size_t q) __attribute__((always_inline)) {
+    const std::size_t b = q * 4;
     const simd::i32x4 ix = simd::floor_clamped(simd::load(x + b) * c.inv_leaf, c.lo, c.hi);
     const simd::i32x4 iy = simd::floor_clamped(simd::load(y + b) * c.inv_leaf, c.lo, c.hi);
     const simd::i32x4 iz = simd::floor_clamped(simd::load(z + b) * c.inv_leaf, c.lo, c.hi);
     if constexpr (std::endian::native == std::endian::little) {
-      // pack(x, y, z, 1) four at a time: the keys' low and high 32-bit halves, interleaved into 64 bits.
+      // An injective key cheaper than pack(): low half (iy << 20) + iz, high half (ix << 8) + (iy >> 12)
+      // (arithmetic), both modulo 2^32. The low half's 20 low bits give iz (|iz| < 2^19), then its top 12
+      // bits iy's low 12; the high half's low 8 bits give iy >> 12 (in [-128, 127]), the rest ix. Its high
+      // half lies in [-2^27, 2^27), which keeps kNoKey and every coarse key (band >= 1 in the top 4 bits)
+      // out of its reach. Only key equality reaches the output, never the key's value.
       using u32x4 = std::uint32_t __attribute__((vector_size(16)));
-      const auto o = static_cast<std::uint32_t>(kCoordOffset);
-      const u32x4 ux = __builtin_convertvector(ix, u32x4) + o;
-      const u32x4 uy = __builtin_convertvector(iy, u32x4) + o;
-      const u32x4 uz = __builtin_convertvector(iz, u32x4) + o;
-      const u32x4 lo = (uy << 20U) | uz;
-      const u32x4 hi = (ux << 8U) | (uy >> 12U) | (1U << 28U);  // band 1 in the top 4 bits
+      const u32x4 uy = __builtin_convertvector(iy, u32x4);
+      const u32x4 lo = (uy << 20U) + __builtin_convertvector(iz, u32x4);
+      const u32x4 hi = (__builtin_convertvector(ix, u32x4) << 8U) + __builtin_convertvector(iy >> 12, u32x4);
       const u32x4 k01 = __builtin_shufflevector(lo, hi, 0, 4, 1, 5);
       const u32x4 k23 = __builtin_shufflevector(lo, hi, 2, 6, 3, 7);
       std::memcpy(keys + b, &k01, sizeof k01);
@@ -66,7 +79,8 @@ inline void block_keys(const float* x, const float* y, const float* z, const Key
       std::memcpy(vz, &iz, sizeof vz);
       for (std::size_t k = 0; k < 4; ++k) keys[b + k] = pack(vx[k], vy[k], vz[k], 1);
     }
-  }
+  };
+  unrolled(four, std::make_index_sequence<kBlock / 4>{});
 }
 
 inline std::uint32_t slot_of(std::uint64_t key, std::uint32_t shift) {
@@ -81,7 +95,8 @@ std::uint32_t log2_ceil(std::size_t n) {
 
 }  // namespace
 
-VoxelGrid::VoxelGrid(const VoxelParams& params) : params_(params) {
+VoxelGrid::VoxelGrid(const VoxelParams& params, std::size_t exact_points)
+    : params_(params), exact_points_(std::clamp<std::size_t>(exact_points, 1, kExactPoints)) {
   if (!(params_.leaf_m > 0.0) || !std::isfinite(params_.leaf_m)) {
     throw std::invalid_argument("VoxelGrid: leaf_m must be positive");
   }
@@ -129,6 +144,7 @@ void VoxelGrid::begin(std::size_t max_points) {
   voxels_ = 0;
   if (sums_.size() < max_points) {
     sums_.resize(max_points);
+    counts_.resize(max_points);
     keys_.resize(max_points);
   }
   if (table_.empty()) grow_table();
@@ -141,48 +157,18 @@ void VoxelGrid::begin(std::size_t max_points) {
   for (auto& c : cache_) {
     c.sum = simd::splat(0.F);
     c.key = kNoKey;
-    c.n = 0;
   }
   queued_ = 0;
-}
-
-// One point into the voxel `key`: into its ring's cache entry `c` while the ring stays in one voxel. When it
-// moves on, the finished run (key, sums, count) is queued; queued runs meet the table in batches.
-// `queued` is the caller's copy of queued_, in a register: as a member, every point would load and store it
-// (the runs' 32-bit stores may alias it), a store-to-load chain through memory from one point to the next.
-inline void VoxelGrid::add(std::uint64_t key, CacheEntry& c, simd::f32x4 p, std::uint32_t& queued) {
-  // Branching on whether the ring stays in its voxel (72 % of the points of BM_Voxel's "shed 5Hz") measured
-  // 3-7 % faster than writing the entry's run to the queue on every point (BM_Voxel, g++ -O2, x86-64, busy
-  // machine; twice, in two sessions), mispredictions and all. The new run starts from +0 + p, as a sum from
-  // zero does (a -0 coordinate becomes +0).
-  if (c.key == key) {
-    c.sum = c.sum + p;  // lanes x, y, z (the fourth is not used)
-    ++c.n;
-    return;
-  }
-  if (c.key != kNoKey) {
-    Run& r = runs_[queued++];
-    r.sum = c.sum;
-    r.key = c.key;
-    r.n = c.n;
-  }
-  c.sum = simd::splat(0.F) + p;
-  c.n = 1U;
-  c.key = key;
-  if (queued == kRunBatch) [[unlikely]] {
-    queued_ = queued;
-    drain_runs();
-    queued = 0;
-  }
+  counted_ = 0;
 }
 
 // The queued runs into their voxels, in queue order (so the voxel ids, and the output order, depend only on
-// the input). First every run's table slot, fetched ahead: the lookups below then rarely wait on memory. One
-// pass after that: a new voxel (half the runs of BM_Voxel's "shed 5Hz") takes its run's sums as they are,
-// without a second pass that adds them to zeros. Measured slower on this machine (BM_Voxel, busy): telling new
-// from known voxels without a branch (masked sums), and fetching a known voxel's key and sums ahead.
-// The table's state is read into locals once: as members, each would be loaded again after every 32-bit store
-// to the table or a sum (may alias).
+// the input). Every run's table slot was computed, and fetched ahead, when it was queued: the lookups below
+// then rarely wait on memory. A new voxel (half the runs of BM_Voxel's "shed 5Hz") takes its run's sums as
+// they are, without a second pass that adds them to zeros. Measured slower on this machine (BM_Voxel, busy): telling
+// new from known voxels without a branch (masked sums), and fetching a known voxel's key and sums ahead. The table's
+// state is read into locals once: as members, each would be loaded again after every 32-bit store to the table or a sum
+// (may alias).
 void VoxelGrid::drain_runs() {
   const std::uint32_t queued = queued_;
   Run* const runs = runs_.data();
@@ -195,15 +181,11 @@ void VoxelGrid::drain_runs() {
   // measured 5 % faster (BM_Voxel "shed 5Hz") for a table of 256 kB there.
   auto limit = static_cast<std::uint32_t>(table_.size() / 4);
   std::uint64_t* const keys = keys_.data();
-  Sum* const sums = sums_.data();
-  for (std::uint32_t j = 0; j < queued; ++j) {
-    runs[j].id = slot_of(runs[j].key, shift);
-    __builtin_prefetch(&table[runs[j].id]);
-  }
+  Vec4* const sums = sums_.data();
   for (std::uint32_t j = 0; j < queued; ++j) {
     const Run& r = runs[j];
     const std::uint64_t key = r.key;
-    std::uint32_t h = r.id;  // the slot, from above
+    std::uint32_t h = r.id;  // the slot, from add_points() or finish()
     for (;;) {
       const std::uint32_t id = table[h] - base;
       if (id >= voxels) {  // empty in this frame: a new voxel
@@ -211,9 +193,7 @@ void VoxelGrid::drain_runs() {
         // starts from +0 + p, and x + y is -0 only when both are).
         const std::uint32_t v = voxels++;
         keys[v] = key;
-        static_assert(sizeof(Sum) == sizeof(Vec4));
-        std::memcpy(&sums[v], &r.sum, sizeof(Sum));
-        sums[v].n = r.n;
+        sums[v] = r.sum;
         if (voxels > limit) [[unlikely]] {
           voxels_ = voxels;
           grow_table();  // re-inserts every key, this one included
@@ -229,11 +209,7 @@ void VoxelGrid::drain_runs() {
         break;
       }
       if (keys[id] == key) {
-        Sum& a = sums[id];
-        a.x += r.sum[0];
-        a.y += r.sum[1];
-        a.z += r.sum[2];
-        a.n += r.n;
+        sums[id] = sums[id] + r.sum;  // x, y, z lane by lane, as three scalar sums; and the counts
         break;
       }
       h = (h + 1) & mask;
@@ -243,42 +219,118 @@ void VoxelGrid::drain_runs() {
   queued_ = 0;
 }
 
-void VoxelGrid::finish(Cloud& out) {
-  for (const auto& c : cache_) {
+// Every open run to the table; the cache is empty after.
+void VoxelGrid::end_runs() {
+  for (auto& c : cache_) {
     if (c.key == kNoKey) continue;
-    runs_[queued_++] = Run{c.sum, c.key, c.n, 0};
-    if (queued_ == kRunBatch) drain_runs();
+    if (queued_ == kRunBatch) drain_runs();  // add_points() may leave the queue full
+    runs_[queued_++] = Run{c.sum, c.key, slot_of(c.key, shift_)};
+    c.key = kNoKey;
   }
   drain_runs();
+}
+
+// The voxels' counts out of their float lanes into counts_, for a frame of more than exact_points_.
+void VoxelGrid::fold_counts() {
+  for (std::uint32_t v = 0; v < voxels_; ++v) {
+    const auto n = static_cast<std::uint32_t>(sums_[v][3]);
+    counts_[v] = (v < counted_ ? counts_[v] : 0U) + n;
+    sums_[v][3] = 0.F;
+  }
+  counted_ = voxels_;
+}
+
+void VoxelGrid::finish(Cloud& out) {
+  end_runs();
+  const bool folded = counted_ > 0;
+  if (folded) fold_counts();
   out.resize_xyz(voxels_);
   float* ox = out.x.data();
   float* oy = out.y.data();
   float* oz = out.z.data();
-  for (std::uint32_t v = 0; v < voxels_; ++v) {
-    const Sum& a = sums_[v];
-    const auto cnt = static_cast<float>(a.n);
-    ox[v] = a.x / cnt;
-    oy[v] = a.y / cnt;
-    oz[v] = a.z / cnt;
+  const Vec4* sums = sums_.data();
+  std::uint32_t v = 0;
+  // Four voxels at a time: their sums transposed into x, y, z and count vectors. The same divisions as one
+  // at a time (IEEE, lane by lane), by the count as a float: exact, and static_cast<float>(n) (below 2^24).
+  for (; !folded && v + 4 <= voxels_; v += 4) {
+    Vec4 x = sums[v], y = sums[v + 1], z = sums[v + 2], n = sums[v + 3];
+    simd::transpose4(x, y, z, n);
+    x = x / n;
+    y = y / n;
+    z = z / n;
+    std::memcpy(ox + v, &x, sizeof x);
+    std::memcpy(oy + v, &y, sizeof y);
+    std::memcpy(oz + v, &z, sizeof z);
+  }
+  for (; v < voxels_; ++v) {
+    const float n = folded ? static_cast<float>(counts_[v]) : sums[v][3];
+    ox[v] = sums[v][0] / n;
+    oy[v] = sums[v][1] / n;
+    oz[v] = sums[v][2] / n;
   }
 }
 
 // Points [0, n) of x, y, z (with a ring each when kRings, else all in ring 0) into their voxels, kBlock keys
 // at a time. A template rather than a test of `ring` per point.
+//
+// A point goes into its ring's cache entry while the ring stays in one voxel. When it moves on, the finished
+// run (key, sums, count) is queued with its table slot, whose memory is fetched ahead; queued runs meet the
+// table in batches (drain_runs()). Branching on whether the ring stays in its voxel (72 % of the points of
+// BM_Voxel's "shed 5Hz") measured 3-7 % faster than writing the entry's run to the queue on every point
+// (BM_Voxel, g++ -O2, x86-64, busy machine; twice, in two sessions), mispredictions and all. A new run starts
+// from +0 + p, as a sum from zero does (a -0 coordinate becomes +0).
+// The queue's length, the table's pointer and shift are locals, in registers: as members, every point would
+// load and store them again (the 32-bit stores of the runs may alias them). A full block's points are
+// unrolled, each with its cache entry's byte offset and key at a fixed place in the block's arrays: a loop
+// spent about 7 of the 17 instructions of a point that stays in its voxel on its counter and indexing.
 template <bool kRings>
 void VoxelGrid::add_points(const float* px, const float* py, const float* pz, const std::uint16_t* ring,
                            std::size_t n) {
   std::uint64_t keys[kBlock];
-  simd::f32x4 points[kBlock];  // (x, y, z, 0) of each point of the block
+  simd::f32x4 points[kBlock];        // (x, y, z, 1) of each point of the block
+  std::uint16_t entry[kBlock] = {};  // byte offset of each point's cache entry
   float tx[kBlock] = {}, ty[kBlock] = {}, tz[kBlock] = {};
+  std::uint16_t tr[kBlock] = {};
+  static_assert(sizeof(CacheEntry) * kRingCache <= 0x10000U, "cache entry offsets must fit 16 bits");
+  static_assert(kRunBatch >= kBlock);
   const KeyLanes lanes(inv_[1]);
-  CacheEntry* const cache = cache_.data();
-  std::uint32_t queued = queued_;
+  auto* const cache = reinterpret_cast<unsigned char*>(cache_.data());
+  Run* const runs = runs_.data();
+  Run* next = runs + queued_;  // the queue's end
+  std::uint32_t shift = shift_;
+  const std::uint32_t* table = table_.data();
+  const auto add = [&](std::size_t j) __attribute__((always_inline)) {
+    auto& c = *reinterpret_cast<CacheEntry*>(cache + entry[j]);
+    const std::uint64_t key = keys[j];
+    if (c.key == key) [[likely]] {  // else g++ puts the miss inline and jumps to the hit and back
+      c.sum = c.sum + points[j];    // x, y, z and the count
+      return;
+    }
+    if (c.key != kNoKey) {
+      Run& r = *next++;
+      r.sum = c.sum;
+      r.key = c.key;
+      r.id = slot_of(c.key, shift);
+      __builtin_prefetch(&table[r.id]);
+    }
+    c.sum = simd::splat(0.F) + points[j];  // count 1
+    c.key = key;
+  };
   for (std::size_t base = 0; base < n; base += kBlock) {
     const std::size_t m = std::min(kBlock, n - base);
+    // A block queues at most a run a point: the queue is drained before it could overflow, not point by point.
+    // (Where the batches end changes no sum and no voxel id: the runs meet the table in queue order.)
+    if (next > runs + (kRunBatch - kBlock)) {
+      queued_ = static_cast<std::uint32_t>(next - runs);
+      drain_runs();  // may grow the table
+      next = runs;
+      shift = shift_;
+      table = table_.data();
+    }
     const float* bx = px + base;
     const float* by = py + base;
     const float* bz = pz + base;
+    const std::uint16_t* br = kRings ? ring + base : nullptr;
     if (m < kBlock) {  // the tail, through a padded copy
       std::copy_n(bx, m, tx);
       std::copy_n(by, m, ty);
@@ -286,6 +338,10 @@ void VoxelGrid::add_points(const float* px, const float* py, const float* pz, co
       bx = tx;
       by = ty;
       bz = tz;
+      if constexpr (kRings) {
+        std::copy_n(br, m, tr);
+        br = tr;
+      }
     }
     if (coarse_) {
       for (std::size_t j = 0; j < m; ++j) keys[j] = coarse_key(bx[j], by[j], bz[j]);
@@ -293,29 +349,52 @@ void VoxelGrid::add_points(const float* px, const float* py, const float* pz, co
       block_keys(bx, by, bz, lanes, keys);
     }
     // Four points' coordinates at a time into one vector each, by a transpose rather than point by point.
-    for (std::size_t b = 0; b < kBlock; b += 4) {
-      simd::f32x4 x = simd::load(bx + b), y = simd::load(by + b), z = simd::load(bz + b), w = simd::splat(0.F);
+    const auto transpose = [&](std::size_t q) __attribute__((always_inline)) {
+      const std::size_t b = q * 4;
+      simd::f32x4 x = simd::load(bx + b), y = simd::load(by + b), z = simd::load(bz + b), w = simd::splat(1.F);
       simd::transpose4(x, y, z, w);
       points[b] = x;
       points[b + 1] = y;
       points[b + 2] = z;
       points[b + 3] = w;
+    };
+    unrolled(transpose, std::make_index_sequence<kBlock / 4>{});
+    if constexpr (kRings) {  // eight rings at a time into their entries' offsets (without rings, all 0)
+      using u16x8 = std::uint16_t __attribute__((vector_size(16)));
+      const auto eight = [&](std::size_t q) __attribute__((always_inline)) {
+        u16x8 r;
+        std::memcpy(&r, br + q * 8, sizeof r);
+        r = (r & static_cast<std::uint16_t>(kRingCache - 1)) * static_cast<std::uint16_t>(sizeof(CacheEntry));
+        std::memcpy(entry + q * 8, &r, sizeof r);
+      };
+      unrolled(eight, std::make_index_sequence<kBlock / 8>{});
     }
-    for (std::size_t j = 0; j < m; ++j) {
-      CacheEntry& c = cache[kRings ? ring[base + j] & (kRingCache - 1) : 0U];
-      add(keys[j], c, points[j], queued);
+    if (m == kBlock) {
+      unrolled(add, std::make_index_sequence<kBlock>{});
+    } else {
+      for (std::size_t j = 0; j < m; ++j) add(j);
     }
   }
-  queued_ = queued;
+  queued_ = static_cast<std::uint32_t>(next - runs);
 }
 
 void VoxelGrid::filter(const Cloud& in, Cloud& out) {
   const std::size_t n = in.size();
   begin(n);
-  if (in.ring.size() == n) {
-    add_points<true>(in.x.data(), in.y.data(), in.z.data(), in.ring.data(), n);
-  } else {
-    add_points<false>(in.x.data(), in.y.data(), in.z.data(), nullptr, n);
+  const bool rings = in.ring.size() == n;
+  for (std::size_t start = 0;;) {
+    const std::size_t m = std::min(exact_points_, n - start);
+    if (rings) {
+      add_points<true>(in.x.data() + start, in.y.data() + start, in.z.data() + start, in.ring.data() + start, m);
+    } else {
+      add_points<false>(in.x.data() + start, in.y.data() + start, in.z.data() + start, nullptr, m);
+    }
+    start += m;
+    if (start == n) break;
+    // Counts in float lanes are exact below 2^24: before more points could take one beyond, every open run
+    // ends (runs restart, so this changes sums' order, only for such a frame) and the counts move to integers.
+    end_runs();
+    fold_counts();
   }
   finish(out);
 }

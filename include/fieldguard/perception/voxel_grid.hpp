@@ -23,8 +23,11 @@ namespace fieldguard::perception {
 
 class VoxelGrid {
  public:
-  // Throws std::invalid_argument for a leaf that is not positive.
-  explicit VoxelGrid(const VoxelParams& params);
+  // Counts are summed in float lanes, exact below 2^24 = kExactPoints + 1: a frame of more points is taken in
+  // pieces of `exact_points` (at most kExactPoints; fewer only for tests), its counts moved to integers
+  // between pieces. Throws std::invalid_argument for a leaf that is not positive.
+  static constexpr std::size_t kExactPoints = (std::size_t{1} << 24) - 1;
+  explicit VoxelGrid(const VoxelParams& params, std::size_t exact_points = kExactPoints);
 
   // `out` gets the centroids (no rings). `in` and `out` must be different clouds.
   void filter(const Cloud& in, Cloud& out);
@@ -32,35 +35,31 @@ class VoxelGrid {
   [[nodiscard]] const VoxelParams& params() const { return params_; }
 
  private:
-  struct Sum {
-    float x, y, z;
-    std::uint32_t n;
-  };
   using Vec4 = vec4::f32x4;
   struct CacheEntry {
-    Vec4 sum;  // x, y, z, (unused)
+    Vec4 sum;  // x, y, z, count
     std::uint64_t key;
-    std::uint32_t n;
   };
   struct Run {  // a ring's points in one voxel, waiting for the table
-    Vec4 sum;
+    Vec4 sum;   // x, y, z, count
     std::uint64_t key;
-    std::uint32_t n;
-    std::uint32_t id;  // scratch of drain_runs(): the key's first table slot
+    std::uint32_t id;  // the key's first table slot
   };
   static constexpr std::size_t kRingCache = 128;
   static constexpr std::uint32_t kRunBatch = 64;
 
   void begin(std::size_t max_points);
-  void add(std::uint64_t key, CacheEntry& c, Vec4 p, std::uint32_t& queued);
   template <bool kRings>
   void add_points(const float* x, const float* y, const float* z, const std::uint16_t* ring, std::size_t n);
   void drain_runs();
+  void end_runs();
+  void fold_counts();
   void finish(Cloud& out);
   void grow_table();
   [[nodiscard]] std::uint64_t coarse_key(float x, float y, float z) const;
 
   VoxelParams params_;
+  std::size_t exact_points_;
   bool coarse_ = false;
   std::uint32_t bands_ = 1;
   std::array<float, 16> inv_{};  // inverse leaf per band (1-based)
@@ -70,7 +69,9 @@ class VoxelGrid {
   std::uint32_t mask_ = 0;
   std::uint32_t shift_ = 0;
   std::uint32_t base_ = 1;
-  Buffer<Sum> sums_;
+  Buffer<Vec4> sums_;             // x, y, z, count of each voxel id (the count since the last fold_counts())
+  Buffer<std::uint32_t> counts_;  // of voxel ids below counted_: the counts fold_counts() took out of sums_
+  std::uint32_t counted_ = 0;
   Buffer<std::uint64_t> keys_;  // key of each voxel id, for growing the table
   std::uint32_t voxels_ = 0;
   std::array<CacheEntry, kRingCache> cache_{};
