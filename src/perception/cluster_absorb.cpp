@@ -19,8 +19,11 @@ ClusterAbsorber::ClusterAbsorber(int absorb_max_points, double absorb_margin_m) 
   margin_ = static_cast<float>(absorb_margin_m);
 }
 
-std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
+std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters, Buffer<ClusterBounds>* bounds) {
   const std::size_t nc = clusters.size();
+  if (bounds != nullptr && bounds->size() != nc) {
+    throw std::invalid_argument("ClusterAbsorber: one bounds per cluster");
+  }
   if (max_points_ == 0 || nc < 2) return 0;
   const std::size_t n = cloud.size();
   boxes_.resize(nc);
@@ -29,6 +32,12 @@ std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
     const auto members = clusters[c];
     if (members.empty()) {  // stays out of every test below: an empty box would hold nothing, fit anywhere
       boxes_[c] = Box{{0.F, 0.F, 0.F}, {0.F, 0.F, 0.F}};
+      continue;
+    }
+    if (bounds != nullptr) {  // the same box: the least and greatest of each coordinate
+      const ClusterBounds& b = (*bounds)[c];
+      boxes_[c] = Box{{b.min[0], b.min[1], b.min[2]}, {b.max[0], b.max[1], b.max[2]}};
+      if (members.size() > max_points_) big_.push_back(static_cast<std::uint32_t>(c));
       continue;
     }
     // One pass, each index checked before its point is read; the bounds in six scalars (written as a loop over
@@ -91,6 +100,7 @@ std::uint32_t ClusterAbsorber::absorb(const Cloud& cloud, Clusters& clusters) {
   if (moved == 0) return 0;
 
   merge_clusters({target_.data(), nc}, n, clusters, of_point_, id_, count_);
+  if (bounds != nullptr) merge_bounds({target_.data(), nc}, id_, clusters.size(), *bounds, merged_bounds_);
   return moved;
 }
 

@@ -51,6 +51,84 @@ ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m, st
   return s;
 }
 
+namespace {
+
+constexpr float kBig = std::numeric_limits<float>::max();
+
+// The bounds of no point: what summarize's running figures start from.
+ClusterBounds no_bounds(bool all_guessed) {
+  return ClusterBounds{{kBig, kBig, kBig}, {-kBig, -kBig, -kBig}, kBig, -kBig, kBig, all_guessed};
+}
+
+}  // namespace
+
+void bound_clusters(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
+                    const Clusters& clusters, Buffer<ClusterBounds>& out) {
+  const std::size_t n = cloud.size(), nc = clusters.size();
+  if (height_m.size() < n || (!guessed.empty() && guessed.size() < n)) {
+    throw std::out_of_range("bound_clusters: fewer heights or guesses than points");
+  }
+  out.resize(nc);
+  // summarize's loop, step for step (the same figures in the same order, so the same bits), over every cluster.
+  for (std::size_t c = 0; c < nc; ++c) {
+    float lo[3] = {kBig, kBig, kBig}, hi[3] = {-kBig, -kBig, -kBig};
+    float r2 = kBig, top = -kBig, bottom = kBig;
+    bool all_guessed = !guessed.empty();
+    for (const std::uint32_t i : clusters[c]) {
+      if (i >= n) throw std::out_of_range("bound_clusters: a cluster indexes a point past the cloud's end");
+      all_guessed = all_guessed && guessed[i] != 0U;
+      const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
+      lo[0] = std::min(lo[0], x);
+      hi[0] = std::max(hi[0], x);
+      lo[1] = std::min(lo[1], y);
+      hi[1] = std::max(hi[1], y);
+      lo[2] = std::min(lo[2], z);
+      hi[2] = std::max(hi[2], z);
+      r2 = std::min(r2, x * x + y * y);
+      top = std::max(top, height_m[i]);
+      bottom = std::min(bottom, height_m[i]);
+    }
+    out[c] = ClusterBounds{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, r2, top, bottom, all_guessed};
+  }
+}
+
+void merge_bounds(std::span<const std::uint32_t> target, std::span<const std::uint32_t> id, std::size_t merged,
+                  Buffer<ClusterBounds>& bounds, Buffer<ClusterBounds>& scratch) {
+  constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+  if (bounds.size() != target.size()) throw std::invalid_argument("merge_bounds: one target per cluster's bounds");
+  // Every merged cluster has a part, whose own all-of started from whether there are guesses at all.
+  scratch.assign(merged, no_bounds(true));
+  // In cluster order, each part folded in as summarize folds in points (a tie keeps what it has).
+  for (std::size_t c = 0; c < target.size(); ++c) {
+    const std::uint32_t g = id[target[c]];
+    if (g == kNone) continue;  // an empty cluster whose group got no point
+    if (g >= merged) throw std::out_of_range("merge_bounds: a cluster past the merged ones");
+    ClusterBounds& a = scratch[g];
+    const ClusterBounds& b = bounds[c];
+    for (std::size_t k = 0; k < 3; ++k) {
+      a.min[k] = std::min(a.min[k], b.min[k]);
+      a.max[k] = std::max(a.max[k], b.max[k]);
+    }
+    a.r2 = std::min(a.r2, b.r2);
+    a.top = std::max(a.top, b.top);
+    a.bottom = std::min(a.bottom, b.bottom);
+    a.ground_guessed = a.ground_guessed && b.ground_guessed;
+  }
+  std::swap(bounds, scratch);
+}
+
+ClusterSummary summary_of(const ClusterBounds& b, std::uint32_t points) {
+  ClusterSummary s;
+  s.points = points;
+  s.min = b.min;
+  s.max = b.max;
+  s.distance_m = std::sqrt(b.r2);
+  s.height_above_ground_m = b.top;
+  s.lowest_above_ground_m = b.bottom;
+  s.ground_guessed = b.ground_guessed;
+  return s;
+}
+
 void limit_height_to_extent(ClusterSummary& s, float floor_z) {
   if (!s.ground_guessed) return;
   s.height_above_ground_m = std::min(s.height_above_ground_m, s.max[2] - std::min(floor_z, s.min[2]));

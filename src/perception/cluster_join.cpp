@@ -51,8 +51,9 @@ float ClusterJoiner::gap_between(std::size_t a, std::size_t b) const {
 }
 
 std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> height_m, const FilterParams& filters,
-                                  Clusters& clusters) {
+                                  Clusters& clusters, Buffer<ClusterBounds>* bounds) {
   const std::size_t nc = clusters.size();
+  if (bounds != nullptr && bounds->size() != nc) throw std::invalid_argument("ClusterJoiner: one bounds per cluster");
   const bool fragments = params_.gap_m > 0.0;
   if (!(params_.float_height_m > 0.0) || (!fragments && !params_.stacked) || nc < 2) return 0;
   const std::size_t n = cloud.size();
@@ -64,7 +65,16 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
     const auto members = clusters[c];
     Info s{{kBig, kBig}, {-kBig, -kBig}, false, false, members.empty()};
     float low = kBig, r2 = kBig;
-    for (const std::uint32_t i : members) {
+    if (bounds != nullptr) {  // the same figures: each a least or a greatest over the members
+      const ClusterBounds& b = (*bounds)[c];
+      s.lo[0] = b.min[0];
+      s.lo[1] = b.min[1];
+      s.hi[0] = b.max[0];
+      s.hi[1] = b.max[1];
+      low = b.bottom;
+      r2 = b.r2;
+    }
+    for (const std::uint32_t i : bounds != nullptr ? std::span<const std::uint32_t>{} : members) {
       if (i >= n) throw std::out_of_range("ClusterJoiner: a cluster indexes a point past the cloud's end");
       const float x = cloud.x[i], y = cloud.y[i];
       s.lo[0] = std::min(s.lo[0], x);
@@ -157,6 +167,7 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
   root_.resize(nc);
   for (std::size_t c = 0; c < nc; ++c) root_[c] = find(static_cast<std::uint32_t>(c));
   merge_clusters({root_.data(), nc}, n, clusters, of_point_, id_, count_);
+  if (bounds != nullptr) merge_bounds({root_.data(), nc}, id_, clusters.size(), *bounds, merged_bounds_);
   return joined;
 }
 

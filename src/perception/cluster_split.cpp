@@ -6,9 +6,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "perception/simd.hpp"
+
 namespace fieldguard::perception {
 
 namespace {
+
+using f64x2 = double __attribute__((vector_size(16)));
 
 // A part also needs this share of the cluster's points, and never fewer than kMinPartPoints: a handful of stray
 // returns at one end of a crown is not a second crown.
@@ -154,22 +158,23 @@ std::uint32_t ClusterSplitter::split(const Cloud& cloud, const EuclideanClustere
     const auto members = clusters[c];
     if (members.size() < 2 * kMinPartPoints) continue;
     // Its x-y box (whose diagonal bounds its extent along any axis: most clusters end here) and moments, in one pass.
-    Spread sp{
-        static_cast<double>(cloud.x[members[0]]),   static_cast<double>(cloud.y[members[0]]),  0.0, 0.0, 0.0, 0.0, 0.0,
-        {cloud.x[members[0]], cloud.y[members[0]]}, {cloud.x[members[0]], cloud.y[members[0]]}};
+    // x and y side by side in one vector: each lane's sums take the same steps in the same order as two scalars
+    // would (the same bits), in half the instructions.
+    const float x0 = cloud.x[members[0]], y0 = cloud.y[members[0]];
+    const f64x2 origin = {static_cast<double>(x0), static_cast<double>(y0)};
+    f64x2 sum = {0.0, 0.0}, square = {0.0, 0.0};
+    double sxy = 0.0;
+    simd::f32x4 lo = {x0, y0, 0.F, 0.F}, hi = lo;
     for (const std::uint32_t i : members) {
-      const float x = cloud.x[i], y = cloud.y[i];
-      sp.lo[0] = std::min(sp.lo[0], x);
-      sp.hi[0] = std::max(sp.hi[0], x);
-      sp.lo[1] = std::min(sp.lo[1], y);
-      sp.hi[1] = std::max(sp.hi[1], y);
-      const double dx = static_cast<double>(x) - sp.x0, dy = static_cast<double>(y) - sp.y0;
-      sp.sx += dx;
-      sp.sy += dy;
-      sp.sxx += dx * dx;
-      sp.sxy += dx * dy;
-      sp.syy += dy * dy;
+      const simd::f32x4 p = {cloud.x[i], cloud.y[i], 0.F, 0.F};
+      lo = simd::min_or_bound(p, lo);  // p < lo ? p : lo, as std::min(lo, p)
+      hi = simd::max_or_bound(p, hi);  // p > hi ? p : hi, as std::max(hi, p)
+      const f64x2 d = __builtin_convertvector(__builtin_shufflevector(p, p, 0, 1), f64x2) - origin;
+      sum += d;
+      square += d * d;
+      sxy += d[0] * d[1];
     }
+    const Spread sp{origin[0], origin[1], sum[0], sum[1], square[0], sxy, square[1], {lo[0], lo[1]}, {hi[0], hi[1]}};
     if (std::hypot(sp.hi[0] - sp.lo[0], sp.hi[1] - sp.lo[1]) < min_len) continue;
     float cut = 0.F;
     if (!find_cut(cloud, clusterer, members, sp, cut)) continue;

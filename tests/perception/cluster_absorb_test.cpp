@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -17,6 +18,16 @@ namespace {
 using testing::clusters_of;
 using testing::Sets;
 using testing::sets_of;
+
+// Bit for bit, field by field (not memcmp: the struct's padding is not part of it).
+bool same_bounds(const ClusterBounds& a, const ClusterBounds& b) {
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (bits(a.min[k]) != bits(b.min[k]) || bits(a.max[k]) != bits(b.max[k])) return false;
+  }
+  return bits(a.r2) == bits(b.r2) && bits(a.top) == bits(b.top) && bits(a.bottom) == bits(b.bottom) &&
+         a.ground_guessed == b.ground_guessed;
+}
 
 // A crown's body: a 4 x 4 x 4 lattice of 0.5 m (x 10..11.5 m, 64 points), and three stray returns behind it.
 Cloud crown_with_fragments() {
@@ -104,6 +115,8 @@ TEST(ClusterAbsorber, PartialClusteringAndBadInput) {
   EXPECT_EQ(sets_of(k), (Sets{joined}));
   Clusters bad = clusters_of({body, {67}});
   EXPECT_THROW(a.absorb(c, bad), std::out_of_range);
+  Buffer<ClusterBounds> one_more(k.size() + 1);
+  EXPECT_THROW(a.absorb(c, k, &one_more), std::invalid_argument);
   EXPECT_THROW(ClusterAbsorber(-1, 0.3), std::invalid_argument);
   EXPECT_THROW(ClusterAbsorber(10, -0.1), std::invalid_argument);
   EXPECT_THROW(ClusterAbsorber(10, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
@@ -183,6 +196,74 @@ TEST(ClusterAbsorber, TakesTheFirstHoldingBoxAsOneAtATime) {
     for (auto& m : expected) std::sort(m.begin(), m.end());
     std::sort(expected.begin(), expected.end());
     EXPECT_EQ(sets_of(k), expected) << "trial " << trial;
+    // With bounds given (the pipeline's way): the same result, and the bounds of the merged clusters.
+    Clusters kb = clusters_of(sets);
+    const std::vector<float> h(c.z.begin(), c.z.end());
+    Buffer<ClusterBounds> bounds, fresh;
+    bound_clusters(c, h, {}, kb, bounds);
+    ClusterAbsorber with_bounds(10, static_cast<double>(margin));
+    ASSERT_EQ(with_bounds.absorb(c, kb, &bounds), moved) << "trial " << trial;
+    EXPECT_EQ(sets_of(kb), expected) << "trial " << trial;
+    bound_clusters(c, h, {}, kb, fresh);
+    ASSERT_EQ(bounds.size(), fresh.size()) << "trial " << trial;
+    for (std::size_t q = 0; q < fresh.size(); ++q) {
+      EXPECT_TRUE(same_bounds(bounds[q], fresh[q])) << "trial " << trial << " cluster " << q;
+    }
+  }
+}
+
+// merge_clusters (the absorber's and the joiner's regrouping) against sets merged by hand: clusters in the
+// clusterer's order (merged cluster by cluster) and out of it (regrouped point by point), one big cluster taking
+// a few small ones (merged by bisection) or several of any size (merged in one sweep), empty clusters among them.
+TEST(MergeClusters, AsTheMergedSetsInTheOrderOfTheirLowestPoint) {
+  std::uint32_t state = 12345U;
+  const auto next = [&state](std::uint32_t below) {
+    state = state * 1664525U + 1013904223U;
+    return (state >> 8) % below;
+  };
+  Buffer<std::uint32_t> of_point, id, scratch;
+  for (int trial = 0; trial < 400; ++trial) {
+    const std::uint32_t n = 1 + next(600);
+    const std::uint32_t labels = 1 + next(40);
+    // Label 0 takes most points in half the trials: a big cluster and small ones.
+    const bool skewed = trial % 2 == 0;
+    Sets sets(labels);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (trial % 5 == 0 && next(10) == 0) continue;  // in no cluster
+      const std::uint32_t l = skewed && next(100) < 95 ? 0 : next(labels);
+      sets[l].push_back(i);
+    }
+    const bool in_order = trial % 3 != 0;
+    if (in_order) {
+      std::stable_sort(sets.begin(), sets.end(), [](const auto& a, const auto& b) {
+        return !a.empty() && (b.empty() || a.front() < b.front());
+      });
+    } else {
+      for (std::size_t k = sets.size(); k > 1; --k) std::swap(sets[k - 1], sets[next(static_cast<std::uint32_t>(k))]);
+      for (auto& m : sets) {
+        if (next(2) == 0) std::reverse(m.begin(), m.end());
+      }
+    }
+    // Each cluster goes to a root: itself, or one of the few clusters that are their own roots.
+    const std::size_t nc = sets.size();
+    std::vector<std::uint32_t> target(nc);
+    for (std::size_t c = 0; c < nc; ++c) {
+      const std::uint32_t root = next(std::min<std::uint32_t>(4, static_cast<std::uint32_t>(nc)));
+      target[c] = next(3) == 0 ? static_cast<std::uint32_t>(c) : root;
+    }
+    for (std::size_t c = 0; c < nc; ++c) target[target[c]] = target[c];
+    Sets expected(nc);
+    for (std::size_t c = 0; c < nc; ++c) {
+      expected[target[c]].insert(expected[target[c]].end(), sets[c].begin(), sets[c].end());
+    }
+    expected.erase(std::remove_if(expected.begin(), expected.end(), [](const auto& m) { return m.empty(); }),
+                   expected.end());
+    for (auto& m : expected) std::sort(m.begin(), m.end());
+    std::sort(expected.begin(), expected.end());
+    Clusters k = clusters_of(sets);
+    merge_clusters(target, n, k, of_point, id, scratch);
+    ASSERT_EQ(sets_of(k), expected) << "trial " << trial;
+    ASSERT_EQ(k.offsets.size(), expected.size() + 1) << "trial " << trial;
   }
 }
 

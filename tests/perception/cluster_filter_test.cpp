@@ -2,9 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <limits>
+#include <span>
+#include <stdexcept>
 #include <vector>
+
+#include "fieldguard/perception/euclidean_cluster.hpp"
 
 #include "perception/test_clouds.hpp"
 
@@ -144,6 +150,82 @@ TEST(ClusterFilter, Summary) {
   EXPECT_EQ(s.min, (std::array<float, 3>{3.F, 4.F, -0.5F}));
   EXPECT_EQ(s.max, (std::array<float, 3>{6.F, 8.F, 0.5F}));
   EXPECT_FLOAT_EQ(s.volume_m3(), 12.F);
+}
+
+// Bit for bit (a signed zero or a NaN would tell summary_of from summarize where == could not).
+void expect_same_summary(const ClusterSummary& a, const ClusterSummary& b, int trial) {
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  EXPECT_EQ(a.points, b.points) << "trial " << trial;
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(bits(a.min[k]), bits(b.min[k])) << "trial " << trial;
+    EXPECT_EQ(bits(a.max[k]), bits(b.max[k])) << "trial " << trial;
+  }
+  EXPECT_EQ(bits(a.distance_m), bits(b.distance_m)) << "trial " << trial;
+  EXPECT_EQ(bits(a.height_above_ground_m), bits(b.height_above_ground_m)) << "trial " << trial;
+  EXPECT_EQ(bits(a.lowest_above_ground_m), bits(b.lowest_above_ground_m)) << "trial " << trial;
+  EXPECT_EQ(a.ground_guessed, b.ground_guessed) << "trial " << trial;
+}
+
+// The pipeline summarizes from bounds found once for all clusters and merged along (bound_clusters,
+// merge_bounds): each cluster's must be summarize's, before and after a merge, with and without guesses.
+TEST(ClusterFilter, BoundsGiveTheSummaryBeforeAndAfterAMerge) {
+  testing::TestRng rng(7);
+  Buffer<std::uint32_t> of_point, id, scratch;
+  Buffer<ClusterBounds> bounds, bounds_scratch;
+  for (int trial = 0; trial < 60; ++trial) {
+    Cloud c;
+    std::vector<float> h;
+    std::vector<std::uint8_t> guessed;
+    const auto n = static_cast<std::uint32_t>(1 + rng.uniform(0.F, 300.F));
+    for (std::uint32_t i = 0; i < n; ++i) {
+      c.push_back(rng.uniform(-30.F, 30.F), rng.uniform(-30.F, 30.F), rng.uniform(-2.F, 4.F));
+      h.push_back(rng.uniform(-0.5F, 3.F));
+      guessed.push_back(rng.uniform(0.F, 1.F) < (trial % 3 == 0 ? 0.97F : 0.5F) ? 1U : 0U);
+    }
+    // Points dealt to clusters in order (so in the clusterer's order), an empty cluster now and then.
+    const auto nc = static_cast<std::uint32_t>(1 + rng.uniform(0.F, 20.F));
+    testing::Sets sets(nc);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      sets[std::min(nc - 1, static_cast<std::uint32_t>(rng.uniform(0.F, static_cast<float>(nc))))].push_back(i);
+    }
+    std::stable_sort(sets.begin(), sets.end(), [](const auto& a, const auto& b) {
+      return !a.empty() && (b.empty() || a.front() < b.front());
+    });
+    Clusters k = testing::clusters_of(sets);
+    const std::span<const std::uint8_t> g = trial % 2 == 0 ? std::span<const std::uint8_t>{guessed} : std::span<const std::uint8_t>{};
+    bound_clusters(c, h, g, k, bounds);
+    ASSERT_EQ(bounds.size(), k.size());
+    for (std::size_t j = 0; j < k.size(); ++j) {
+      if (k[j].empty()) continue;
+      expect_same_summary(summary_of(bounds[j], static_cast<std::uint32_t>(k[j].size())), summarize(c, h, g, k[j]),
+                          trial);
+    }
+    // Every cluster to one of the first three, or kept.
+    std::vector<std::uint32_t> target(k.size());
+    for (std::size_t j = 0; j < k.size(); ++j) {
+      target[j] = rng.uniform(0.F, 1.F) < 0.5F ? static_cast<std::uint32_t>(j)
+                                                : std::min<std::uint32_t>(static_cast<std::uint32_t>(j),
+                                                                          static_cast<std::uint32_t>(rng.uniform(0.F, 3.F)));
+    }
+    for (std::size_t j = 0; j < k.size(); ++j) target[j] = target[target[j]];
+    merge_clusters(target, n, k, of_point, id, scratch);
+    merge_bounds(target, id, k.size(), bounds, bounds_scratch);
+    ASSERT_EQ(bounds.size(), k.size());
+    for (std::size_t j = 0; j < k.size(); ++j) {
+      expect_same_summary(summary_of(bounds[j], static_cast<std::uint32_t>(k[j].size())), summarize(c, h, g, k[j]),
+                          trial);
+    }
+  }
+  Cloud c;
+  c.push_back(1.F, 1.F, 1.F);
+  const std::vector<float> h{0.5F};
+  Clusters past = testing::clusters_of({{0, 1}});
+  EXPECT_THROW(bound_clusters(c, h, {}, past, bounds), std::out_of_range);
+  Clusters ok = testing::clusters_of({{0}});
+  EXPECT_THROW(bound_clusters(c, {}, {}, ok, bounds), std::out_of_range);
+  bound_clusters(c, h, {}, ok, bounds);
+  const std::vector<std::uint32_t> two_targets{0, 0};
+  EXPECT_THROW(merge_bounds(two_targets, id, 1, bounds, bounds_scratch), std::invalid_argument);
 }
 
 // Standing only on guessed ground (nothing measured near), a cluster's height is at most what it shows: one

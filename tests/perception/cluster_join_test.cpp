@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -19,6 +20,16 @@ namespace {
 using testing::clusters_of;
 using testing::Sets;
 using testing::sets_of;
+
+// Bit for bit, field by field (not memcmp: the struct's padding is not part of it).
+bool same_bounds(const ClusterBounds& a, const ClusterBounds& b) {
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (bits(a.min[k]) != bits(b.min[k]) || bits(a.max[k]) != bits(b.max[k])) return false;
+  }
+  return bits(a.r2) == bits(b.r2) && bits(a.top) == bits(b.top) && bits(a.bottom) == bits(b.bottom) &&
+         a.ground_guessed == b.ground_guessed;
+}
 
 std::vector<std::uint32_t> range(std::uint32_t from, std::uint32_t to) {
   std::vector<std::uint32_t> r;
@@ -311,6 +322,18 @@ TEST(ClusterJoiner, SweepAgreesWithEveryPairCompared) {
       EXPECT_EQ(sets_of(k), want) << "run " << run;
     }
     EXPECT_EQ(n, in.size() - want.size()) << "run " << run;
+    // With bounds given (the pipeline's way): the same joins, and the bounds of the joined clusters.
+    Clusters kb = clusters_of(in);
+    Buffer<ClusterBounds> bounds, fresh;
+    bound_clusters(c, h, {}, kb, bounds);
+    ClusterJoiner jb(p);
+    EXPECT_EQ(jb.join(c, h, filters(), kb, &bounds), n) << "run " << run;
+    EXPECT_EQ(sets_of(kb), sets_of(k)) << "run " << run;
+    bound_clusters(c, h, {}, kb, fresh);
+    ASSERT_EQ(bounds.size(), fresh.size()) << "run " << run;
+    for (std::size_t q = 0; q < fresh.size(); ++q) {
+      EXPECT_TRUE(same_bounds(bounds[q], fresh[q])) << "run " << run << " cluster " << q;
+    }
   }
   EXPECT_GT(joins, 100U);  // the scenes must exercise the rules
 }
@@ -329,6 +352,8 @@ TEST(ClusterJoiner, BadInputThrows) {
   Clusters ok = clusters_of({{0}, {1}});
   const std::vector<float> short_h(2, 1.F);
   EXPECT_THROW(j.join(c, short_h, filters(), ok), std::out_of_range);
+  Buffer<ClusterBounds> one(1);
+  EXPECT_THROW(j.join(c, h, filters(), ok, &one), std::invalid_argument);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <cstdint>
 
 #include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/cluster_filter.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 
 namespace fieldguard::perception {
@@ -28,8 +29,9 @@ class ClusterAbsorber {
 
   // `clusters` holds each of `cloud`'s points at most once (EuclideanClusterer's hold each exactly once); rewritten
   // in place. An index past the cloud's end throws std::out_of_range. Returns how many clusters were absorbed.
-  // absorb_max_points 0: does nothing.
-  std::uint32_t absorb(const Cloud& cloud, Clusters& clusters);
+  // absorb_max_points 0: does nothing. `bounds`, when given: bound_clusters of `clusters` (their boxes are taken
+  // from it), merged along (one per cluster, or std::invalid_argument).
+  std::uint32_t absorb(const Cloud& cloud, Clusters& clusters, Buffer<ClusterBounds>* bounds = nullptr);
 
  private:
   struct Box {
@@ -37,6 +39,7 @@ class ClusterAbsorber {
     float hi[3];
   };
   std::uint32_t max_points_;
+  Buffer<ClusterBounds> merged_bounds_;
   float margin_;
   // Scratch, reused across frames.
   Buffer<Box> boxes_;

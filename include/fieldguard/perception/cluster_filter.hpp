@@ -9,6 +9,7 @@
 
 #include "fieldguard/perception/canopy.hpp"
 #include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/params.hpp"
 
 namespace fieldguard::perception {
@@ -31,6 +32,32 @@ enum class Rejection : std::uint8_t { Kept = 0, TooFewPoints, TooManyPoints, Too
 // (empty: none is).
 [[nodiscard]] ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m,
                                        std::span<const std::uint8_t> guessed, std::span<const std::uint32_t> indices);
+
+// summarize's figures for every cluster of a frame in one pass, in a form that merges: each a least, a greatest or
+// an all-of over the cluster's points, so the bounds of two clusters merged are the bounds of the two (the
+// absorber and the joiner keep them so), and summary_of gives what summarize would. (The frame's clusters hold most
+// of its points: one pass over them instead of one per stage.)
+struct ClusterBounds {
+  std::array<float, 3> min;  // axis-aligned box (m)
+  std::array<float, 3> max;
+  float r2;      // the least x^2 + y^2 (m^2)
+  float top;     // the greatest height above the local ground
+  float bottom;  // ... and the least
+  bool ground_guessed;
+};
+
+// The bounds of each of `clusters` (of `cloud`'s points), `height_m` and `guessed` as for summarize. An index past
+// the cloud's end, or fewer heights (or guesses, unless none) than points, throws std::out_of_range.
+void bound_clusters(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
+                    const Clusters& clusters, Buffer<ClusterBounds>& out);
+
+// The bounds after merge_clusters (euclidean_cluster.hpp) with `target` left `id` (each target's cluster after
+// the merge, or none when it got no point), into `merged` clusters. `scratch` is reused.
+void merge_bounds(std::span<const std::uint32_t> target, std::span<const std::uint32_t> id, std::size_t merged,
+                  Buffer<ClusterBounds>& bounds, Buffer<ClusterBounds>& scratch);
+
+// summarize's result for a cluster of `points` points (at least one) with bounds `b`.
+[[nodiscard]] ClusterSummary summary_of(const ClusterBounds& b, std::uint32_t points);
 
 // Where no ground was measured under a cluster (ground_guessed), its height above ground is a guess too: three
 // flat returns of one ring far out are as likely the ground as anything standing on it. Such a cluster's

@@ -26,6 +26,7 @@
 #include <span>
 
 #include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/cluster_filter.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/params.hpp"
 
@@ -49,9 +50,11 @@ class ClusterJoiner {
   // `height_m`: each of `cloud`'s points' height above its local ground; `filters`: the minimum point count at a
   // cluster's distance. `clusters` holds each point at most once; rewritten in place (empty clusters dropped when
   // anything joined). An index past the cloud's end, or fewer heights than points, throws std::out_of_range.
-  // Returns the number of joins made. float_height_m 0: does nothing.
+  // Returns the number of joins made. float_height_m 0: does nothing. `bounds`, when given: bound_clusters of
+  // `clusters` with `height_m` (each cluster's box, lowest height and nearest point are taken from it), merged
+  // along (one per cluster, or std::invalid_argument).
   std::uint32_t join(const Cloud& cloud, std::span<const float> height_m, const FilterParams& filters,
-                     Clusters& clusters);
+                     Clusters& clusters, Buffer<ClusterBounds>* bounds = nullptr);
 
  private:
   struct Info {
@@ -78,6 +81,7 @@ class ClusterJoiner {
   Buffer<std::uint32_t> of_point_;
   Buffer<std::uint32_t> id_;
   Buffer<std::uint32_t> count_;
+  Buffer<ClusterBounds> merged_bounds_;
 };
 
 }  // namespace fieldguard::perception

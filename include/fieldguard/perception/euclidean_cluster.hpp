@@ -47,7 +47,7 @@ void group_by_first_point(Buffer<std::uint32_t>& of_point, std::uint32_t labels,
 
 // Clusters merged in place: cluster c's points go to cluster target[c] (a cluster that is its own target), then
 // the clusters are rebuilt by group_by_first_point (points of a cloud of `points` in no cluster stay in none). The
-// three buffers are scratch, reused.
+// three buffers are scratch, reused; `id` is left holding each target's cluster after the merge (merge_bounds).
 void merge_clusters(std::span<const std::uint32_t> target, std::size_t points, Clusters& clusters,
                     Buffer<std::uint32_t>& of_point, Buffer<std::uint32_t>& id, Buffer<std::uint32_t>& scratch);
 
