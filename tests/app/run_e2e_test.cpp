@@ -386,7 +386,7 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   EXPECT_GE(entries, 3);
   // (c) after it leaves: STOP held for clear - 1 more rotations, GO once `clear` rotations were clear.
   int gos = 0;
-  int sensor_fault_frames = 0;
+  int late_or_fault_frames = 0;
   for (int k = 0; k < kRotations - 1; ++k) {
     if (at(k) == Where::Inside && d.by_frame.count(k) != 0) {
       EXPECT_EQ(d.by_frame.at(k).command, 1) << "rotation " << k;
@@ -400,9 +400,13 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
       const Stop& s = d.by_frame.at(k);
       // Fused, a serial sensor the daemon did not hear for longer than its timeout (the AHRS's is 0.1 s) is a
       // STOP of its own, right whatever the zone says: on this loaded 2-core machine the pseudo-terminals are
-      // sometimes not read for that long (README, Measurements). Such frames are counted, not held to GO.
-      if (fused && s.command == 1 && s.sensor_fault && !s.obstacle) {
-        ++sensor_fault_frames;
+      // sometimes not read for that long (README, Measurements). So is a frame decided more than the deadline
+      // (0.3 s) after its last data: fused, a frame waits for the GNSS fix after its window, which comes late
+      // when the pseudo-terminals are read late (seen once in CI: rotations 63-64 pipeline late, beside 14
+      // sensor-fault frames). Such frames are counted, not held to GO; a daemon late on every frame still
+      // fails the count of GOs below.
+      if (fused && s.command == 1 && (s.sensor_fault || s.pipeline_late) && !s.obstacle) {
+        ++late_or_fault_frames;
         continue;
       }
       ++gos;
@@ -412,7 +416,10 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     }
   }
   EXPECT_GE(gos, 20);
-  if (fused) std::printf("[ measured ] %d clear frames stopped for a silent serial sensor instead\n", sensor_fault_frames);
+  if (fused) {
+    std::printf("[ measured ] %d clear frames stopped for a silent serial sensor or a late frame instead\n",
+                late_or_fault_frames);
+  }
 
   // (b) silence: the last packet came at most one rotation after the last decided rotation's stamp (its
   // closing packet is older than its decision); STOP, sensor fault must follow within timeout + one frame.
