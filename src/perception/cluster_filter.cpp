@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace fieldguard::perception {
 
@@ -20,47 +21,45 @@ std::string_view to_string(Rejection r) {
   return "?";
 }
 
-ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
-                         std::span<const std::uint32_t> indices) {
-  ClusterSummary s;
-  if (indices.empty()) return s;
-  constexpr float kBig = std::numeric_limits<float>::max();
-  float lo[3] = {kBig, kBig, kBig}, hi[3] = {-kBig, -kBig, -kBig};
-  float r2 = kBig, top = -kBig, bottom = kBig;
-  bool all_guessed = !guessed.empty();
-  for (const std::uint32_t i : indices) {
-    all_guessed = all_guessed && guessed[i] != 0U;
-    const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
-    lo[0] = std::min(lo[0], x);
-    hi[0] = std::max(hi[0], x);
-    lo[1] = std::min(lo[1], y);
-    hi[1] = std::max(hi[1], y);
-    lo[2] = std::min(lo[2], z);
-    hi[2] = std::max(hi[2], z);
-    r2 = std::min(r2, x * x + y * y);
-    top = std::max(top, height_m[i]);
-    bottom = std::min(bottom, height_m[i]);
-  }
-  s.points = static_cast<std::uint32_t>(indices.size());
-  s.min = {lo[0], lo[1], lo[2]};
-  s.max = {hi[0], hi[1], hi[2]};
-  s.distance_m = std::sqrt(r2);
-  s.height_above_ground_m = top;
-  s.lowest_above_ground_m = bottom;
-  s.ground_guessed = all_guessed;
-  return s;
-}
-
 namespace {
 
 constexpr float kBig = std::numeric_limits<float>::max();
 
-// The bounds of no point: what summarize's running figures start from.
+// The bounds of no point: what a cluster's running figures start from.
 ClusterBounds no_bounds(bool all_guessed) {
   return ClusterBounds{{kBig, kBig, kBig}, {-kBig, -kBig, -kBig}, kBig, -kBig, kBig, all_guessed};
 }
 
+// One cluster's figures, its points folded in in order (a tie keeps what it has): what summarize reports and
+// bound_clusters keeps, so that both give the same bits. `n` is the cloud's size, for the index check.
+ClusterBounds fold_points(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
+                          std::span<const std::uint32_t> indices, std::size_t n, const char* who) {
+  ClusterBounds b = no_bounds(!guessed.empty());
+  for (const std::uint32_t i : indices) {
+    if (i >= n) throw std::out_of_range(std::string(who) + ": a cluster indexes a point past the cloud's end");
+    b.ground_guessed = b.ground_guessed && guessed[i] != 0U;
+    const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
+    b.min[0] = std::min(b.min[0], x);
+    b.max[0] = std::max(b.max[0], x);
+    b.min[1] = std::min(b.min[1], y);
+    b.max[1] = std::max(b.max[1], y);
+    b.min[2] = std::min(b.min[2], z);
+    b.max[2] = std::max(b.max[2], z);
+    b.r2 = std::min(b.r2, x * x + y * y);
+    b.top = std::max(b.top, height_m[i]);
+    b.bottom = std::min(b.bottom, height_m[i]);
+  }
+  return b;
+}
+
 }  // namespace
+
+ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
+                         std::span<const std::uint32_t> indices) {
+  if (indices.empty()) return ClusterSummary{};
+  return summary_of(fold_points(cloud, height_m, guessed, indices, cloud.size(), "summarize"),
+                    static_cast<std::uint32_t>(indices.size()));
+}
 
 void bound_clusters(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
                     const Clusters& clusters, Buffer<ClusterBounds>& out) {
@@ -69,27 +68,7 @@ void bound_clusters(const Cloud& cloud, std::span<const float> height_m, std::sp
     throw std::out_of_range("bound_clusters: fewer heights or guesses than points");
   }
   out.resize(nc);
-  // summarize's loop, step for step (the same figures in the same order, so the same bits), over every cluster.
-  for (std::size_t c = 0; c < nc; ++c) {
-    float lo[3] = {kBig, kBig, kBig}, hi[3] = {-kBig, -kBig, -kBig};
-    float r2 = kBig, top = -kBig, bottom = kBig;
-    bool all_guessed = !guessed.empty();
-    for (const std::uint32_t i : clusters[c]) {
-      if (i >= n) throw std::out_of_range("bound_clusters: a cluster indexes a point past the cloud's end");
-      all_guessed = all_guessed && guessed[i] != 0U;
-      const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
-      lo[0] = std::min(lo[0], x);
-      hi[0] = std::max(hi[0], x);
-      lo[1] = std::min(lo[1], y);
-      hi[1] = std::max(hi[1], y);
-      lo[2] = std::min(lo[2], z);
-      hi[2] = std::max(hi[2], z);
-      r2 = std::min(r2, x * x + y * y);
-      top = std::max(top, height_m[i]);
-      bottom = std::min(bottom, height_m[i]);
-    }
-    out[c] = ClusterBounds{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}, r2, top, bottom, all_guessed};
-  }
+  for (std::size_t c = 0; c < nc; ++c) out[c] = fold_points(cloud, height_m, guessed, clusters[c], n, "bound_clusters");
 }
 
 void merge_bounds(std::span<const std::uint32_t> target, std::span<const std::uint32_t> id, std::size_t merged,

@@ -29,7 +29,7 @@ enum class Rejection : std::uint8_t { Kept = 0, TooFewPoints, TooManyPoints, Too
 [[nodiscard]] std::string_view to_string(Rejection r);
 
 // `height_m`: every cloud point's height above its local ground; `guessed`: 1 where that ground is a guess
-// (empty: none is).
+// (empty: none is). An index past the cloud's end throws std::out_of_range.
 [[nodiscard]] ClusterSummary summarize(const Cloud& cloud, std::span<const float> height_m,
                                        std::span<const std::uint8_t> guessed, std::span<const std::uint32_t> indices);
 
