@@ -21,6 +21,15 @@ double cross(const P2& o, const P2& a, const P2& b) {
   return (d(a[0]) - d(o[0])) * (d(b[1]) - d(o[1])) - (d(a[1]) - d(o[1])) * (d(b[0]) - d(o[0]));
 }
 
+// Points i .. i + 3 of `all` as four x and four y (two unaligned loads, two shuffles); i + 4 <= all.size().
+inline void load4(std::span<const P2> all, std::size_t i, simd::f32x4& px, simd::f32x4& py) {
+  simd::f32x4 a, b;
+  std::memcpy(&a, &all[i], sizeof a);
+  std::memcpy(&b, &all[i + 2], sizeof b);
+  px = __builtin_shufflevector(a, b, 0, 2, 4, 6);
+  py = __builtin_shufflevector(a, b, 1, 3, 5, 7);
+}
+
 }  // namespace
 
 std::string_view to_string(SizeClass c) { return c == SizeClass::Small ? "small" : "large"; }
@@ -120,18 +129,11 @@ void drop_interior_16(std::span<const P2> all, std::vector<P2>& kept) {
   best_v.fill(simd::splat(-std::numeric_limits<float>::infinity()));
   best_i.fill(simd::splat(std::int32_t{0}));
   simd::f32x4 lo_x = simd::splat(all[0][0]), hi_x = lo_x, lo_y = simd::splat(all[0][1]), hi_y = lo_y;
-  const auto load4 = [&](std::size_t i, simd::f32x4& px, simd::f32x4& py) {
-    simd::f32x4 a, b;
-    std::memcpy(&a, &all[i], sizeof a);
-    std::memcpy(&b, &all[i + 2], sizeof b);
-    px = __builtin_shufflevector(a, b, 0, 2, 4, 6);
-    py = __builtin_shufflevector(a, b, 1, 3, 5, 7);
-  };
   const std::size_t n4 = n - n % 4;
   simd::i32x4 idx{0, 1, 2, 3};
   for (std::size_t i = 0; i < n4; i += 4, idx += 4) {
     simd::f32x4 px, py;
-    load4(i, px, py);
+    load4(all, i, px, py);
     lo_x = px < lo_x ? px : lo_x;
     hi_x = px > hi_x ? px : hi_x;
     lo_y = py < lo_y ? py : lo_y;
@@ -199,7 +201,7 @@ void drop_interior_16(std::span<const P2> all, std::vector<P2>& kept) {
   std::size_t i = 0;
   for (; i + 4 <= n; i += 4) {
     simd::f32x4 px, py;
-    load4(i, px, py);
+    load4(all, i, px, py);
     simd::i32x4 inside = simd::splat(std::int32_t{-1});
     for (std::size_t k = 0; k < edges; ++k) {
       inside &= (ex[k] * (py - ay[k]) - ey[k] * (px - ax[k])) > tol[k];
@@ -346,13 +348,6 @@ void refine(std::vector<P2>& kept, std::span<const P2> corners, float ox, float 
 // kFilterReach: drop_interior_16() instead.
 Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
   const std::size_t n = all.size();
-  const auto load4 = [&](std::size_t i, simd::f32x4& px, simd::f32x4& py) {
-    simd::f32x4 a, b;
-    std::memcpy(&a, &all[i], sizeof a);
-    std::memcpy(&b, &all[i + 2], sizeof b);
-    px = __builtin_shufflevector(a, b, 0, 2, 4, 6);
-    py = __builtin_shufflevector(a, b, 1, 3, 5, 7);
-  };
   // The least and greatest x, y, x + y and x - y, four lanes at a time, values only (the points reaching them are
   // found after: tracking indices too doubled this loop).
   constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -362,7 +357,7 @@ Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
   const std::size_t n4 = n - n % 4;
   for (std::size_t i = 0; i < n4; i += 4) {
     simd::f32x4 px, py;
-    load4(i, px, py);
+    load4(all, i, px, py);
     const simd::f32x4 ps = px + py, pd = px - py;
     wild += ps - ps;  // x + y is not finite when x or y is not
     lo_x = simd::min_or_bound(px, lo_x);
@@ -418,7 +413,7 @@ Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
     std::size_t i = 0;
     for (; i < n4 && missing != 0U; i += 4) {
       simd::f32x4 px, py;
-      load4(i, px, py);
+      load4(all, i, px, py);
       const simd::f32x4 ps = px + py, pd = px - py;
       const simd::i32x4 hit =
           (px == bx0) | (px == bx1) | (py == by0) | (py == by1) | (ps == bs0) | (ps == bs1) | (pd == bd0) | (pd == bd1);
@@ -457,7 +452,7 @@ Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
   std::size_t i = 0;
   for (; i < n4; i += 4) {
     simd::f32x4 px, py;
-    load4(i, px, py);
+    load4(all, i, px, py);
     const simd::f32x4 qx = px - ox, qy = py - oy;
     // Written out: g++ -O2 kept the loop over the edges, at twice the instructions.
     const auto left = [&](std::size_t k) { return (ex[k] * qy - ey[k] * qx) > limit[k]; };

@@ -19,17 +19,8 @@ namespace {
 
 using testing::clusters_of;
 using testing::Sets;
+using testing::same_bounds;
 using testing::sets_of;
-
-// Bit for bit, field by field (not memcmp: the struct's padding is not part of it).
-bool same_bounds(const ClusterBounds& a, const ClusterBounds& b) {
-  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
-  for (std::size_t k = 0; k < 3; ++k) {
-    if (bits(a.min[k]) != bits(b.min[k]) || bits(a.max[k]) != bits(b.max[k])) return false;
-  }
-  return bits(a.r2) == bits(b.r2) && bits(a.top) == bits(b.top) && bits(a.bottom) == bits(b.bottom) &&
-         a.ground_guessed == b.ground_guessed;
-}
 
 std::vector<std::uint32_t> range(std::uint32_t from, std::uint32_t to) {
   std::vector<std::uint32_t> r;

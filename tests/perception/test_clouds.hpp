@@ -2,12 +2,14 @@
 // Hand-made clouds for the perception tests.
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/perception/cloud.hpp"
+#include "fieldguard/perception/cluster_filter.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "perception/random.hpp"
 
@@ -20,6 +22,16 @@ inline Sets sets_of(const Clusters& c) {
   Sets s;
   for (std::size_t i = 0; i < c.size(); ++i) s.emplace_back(c[i].begin(), c[i].end());
   return s;
+}
+
+// Cluster bounds bit for bit, field by field (not memcmp: the struct's padding is not part of it).
+inline bool same_bounds(const ClusterBounds& a, const ClusterBounds& b) {
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (bits(a.min[k]) != bits(b.min[k]) || bits(a.max[k]) != bits(b.max[k])) return false;
+  }
+  return bits(a.r2) == bits(b.r2) && bits(a.top) == bits(b.top) && bits(a.bottom) == bits(b.bottom) &&
+         a.ground_guessed == b.ground_guessed;
 }
 
 inline Clusters clusters_of(const Sets& sets) {
