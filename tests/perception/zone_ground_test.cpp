@@ -311,13 +311,20 @@ TEST(ZoneGround, RefusesALayoutThatIsNone) {
   EXPECT_THROW(ZoneGround{p}, std::invalid_argument);
 }
 
-// segment() bins four points at a time; the surface it leaves is looked up one point at a time (bin_of). The two
-// must agree to the bin everywhere: in each zone, on its edges, beyond the last, at the sensor, and for NaN.
-TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
+// Four zones, edges at 2, 6, 14, 26 and 50 m, rings and sectors growing outwards: the layout the bin tests check
+// bins_of against bin_of on.
+ZoneParams four_zones() {
   ZoneParams p;
   p.edges_m = {2.0, 6.0, 14.0, 26.0, 50.0};
   p.rings = {2, 4, 4, 4};
   p.sectors = {16, 32, 48, 64};
+  return p;
+}
+
+// segment() bins four points at a time; the surface it leaves is looked up one point at a time (bin_of). The two
+// must agree to the bin everywhere: in each zone, on its edges, beyond the last, at the sensor, and for NaN.
+TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
+  const ZoneParams p = four_zones();
   const ZoneGround zones(p);
   Cloud c;
   testing::TestRng rng(7);  // the same points on every machine
@@ -351,14 +358,10 @@ TEST(ZoneGround, BinsFourAtATimeAsOneAtATime) {
   }
 }
 
-// bins_of takes a zone's constants whole where all four points of a step lie in that zone (runs of near points,
-// as a voxel grid gives them), and per point otherwise: runs of four on each side of every zone edge, runs that
-// straddle one, and one point off in a run, must all give bin_of's bins.
+// bins_of picks each lane's zone constants by how many zone ends its range has passed: runs of four on each side
+// of every zone edge, runs that straddle one, and one point off in a run, must all give bin_of's bins.
 TEST(ZoneGround, BinsRunsOfFourInOneZoneAsOneAtATime) {
-  ZoneParams p;
-  p.edges_m = {2.0, 6.0, 14.0, 26.0, 50.0};
-  p.rings = {2, 4, 4, 4};
-  p.sectors = {16, 32, 48, 64};
+  const ZoneParams p = four_zones();
   const ZoneGround zones(p);
   Cloud c;
   testing::TestRng rng(5);
