@@ -62,7 +62,6 @@ inline i32x4 floor_clamped(f32x4 v, f32x4 lo, f32x4 hi) {
   const i32x4 t = __builtin_convertvector(v, i32x4);
   return t + (v < __builtin_convertvector(t, f32x4));  // a true lane is -1
 }
-inline i32x4 floor_clamped(f32x4 v, float limit) { return floor_clamped(v, splat(-limit), splat(limit)); }
 
 using vec4::transpose4;
 
