@@ -154,38 +154,57 @@ void VoxelGrid::begin(std::size_t max_points) {
   } else {
     base_ = static_cast<std::uint32_t>(next - max_points);
   }
-  for (auto& c : cache_) {
-    c.sum = simd::splat(0.F);
-    c.key = kNoKey;
+  for (auto& r : open_) {
+    r.sum = simd::splat(0.F);
+    r.key = kNoKey;
   }
-  queued_ = 0;
+  if (points_.empty()) {
+    points_.resize(kChunk);
+    point_keys_.resize(kChunk);
+    point_slots_.resize(kChunk);
+    positions_.resize(kChunk);
+    ended_.resize(kChunk);
+    by_ring_.resize(kPositions);
+    run_sums_.resize(kPositions);
+    run_keys_.resize(kPositions);
+    queue_.resize(kPositions);
+    queue_slots_.resize(kPositions);
+  }
   counted_ = 0;
 }
 
 // The queued runs into their voxels, in queue order (so the voxel ids, and the output order, depend only on
-// the input). Every run's table slot was computed, and fetched ahead, when it was queued: the lookups below
-// then rarely wait on memory. A new voxel (half the runs of BM_Voxel's "shed 5Hz") takes its run's sums as
-// they are, without a second pass that adds them to zeros. Measured slower on this machine (BM_Voxel, busy): telling
-// new from known voxels without a branch (masked sums), and fetching a known voxel's key and sums ahead. The table's
-// state is read into locals once: as members, each would be loaded again after every 32-bit store to the table or a sum
-// (may alias).
-void VoxelGrid::drain_runs() {
-  const std::uint32_t queued = queued_;
-  Run* const runs = runs_.data();
+// the input): queue_[j] is the position in run_sums_ / run_keys_ of the j-th run's sum and key. Every run's
+// table slot is computed, and its memory fetched ahead, before the first lookup: the lookups below then rarely
+// wait on memory. A new voxel (half the runs of BM_Voxel's "shed 5Hz") takes its run's sums as they are,
+// without a second pass that adds them to zeros. Measured slower on this machine: telling new from known
+// voxels without a branch (masked sums; BM_Voxel), or with the batch's new ids' sums zeroed ahead so that both
+// add ("shed 5Hz" after the other frames: 540 to 590 us); fetching a known voxel's key and sums ahead. The
+// table's state is read into locals once: as members, each would be loaded again after every 32-bit store to
+// the table or a sum (may alias).
+void VoxelGrid::drain_runs(std::uint32_t queued) {
+  const std::uint32_t* const queue = queue_.data();
+  const Vec4* const run_sums = run_sums_.data();
+  const std::uint64_t* const run_keys = run_keys_.data();
+  std::uint32_t* const slots = queue_slots_.data();
   std::uint32_t* table = table_.data();
   std::uint32_t mask = mask_;
   std::uint32_t shift = shift_;
   std::uint32_t base = base_;
   std::uint32_t voxels = voxels_;
+  for (std::uint32_t j = 0; j < queued; ++j) {
+    slots[j] = slot_of(run_keys[queue[j]], shift);
+    __builtin_prefetch(&table[slots[j]]);
+  }
   // At most a quarter of the table taken: a third of the lookups met another voxel's slot at half full;
   // measured 5 % faster (BM_Voxel "shed 5Hz") for a table of 256 kB there.
   auto limit = static_cast<std::uint32_t>(table_.size() / 4);
   std::uint64_t* const keys = keys_.data();
   Vec4* const sums = sums_.data();
   for (std::uint32_t j = 0; j < queued; ++j) {
-    const Run& r = runs[j];
-    const std::uint64_t key = r.key;
-    std::uint32_t h = r.id;  // the slot, from add_points() or finish()
+    const std::uint32_t r = queue[j];
+    const std::uint64_t key = run_keys[r];
+    std::uint32_t h = slots[j];
     for (;;) {
       const std::uint32_t id = table[h] - base;
       if (id >= voxels) {  // empty in this frame: a new voxel
@@ -193,7 +212,7 @@ void VoxelGrid::drain_runs() {
         // starts from +0 + p, and x + y is -0 only when both are).
         const std::uint32_t v = voxels++;
         keys[v] = key;
-        sums[v] = r.sum;
+        sums[v] = run_sums[r];
         if (voxels > limit) [[unlikely]] {
           voxels_ = voxels;
           grow_table();  // re-inserts every key, this one included
@@ -202,32 +221,34 @@ void VoxelGrid::drain_runs() {
           shift = shift_;
           base = base_;
           limit = static_cast<std::uint32_t>(table_.size() / 4);
-          for (std::uint32_t k = j + 1; k < queued; ++k) runs[k].id = slot_of(runs[k].key, shift);  // new size
+          for (std::uint32_t k = j + 1; k < queued; ++k) slots[k] = slot_of(run_keys[queue[k]], shift);  // new size
         } else {
           table[h] = base + v;
         }
         break;
       }
       if (keys[id] == key) {
-        sums[id] = sums[id] + r.sum;  // x, y, z lane by lane, as three scalar sums; and the counts
+        sums[id] = sums[id] + run_sums[r];  // x, y, z lane by lane, as three scalar sums; and the counts
         break;
       }
       h = (h + 1) & mask;
     }
   }
   voxels_ = voxels;
-  queued_ = 0;
 }
 
-// Every open run to the table; the cache is empty after.
+// Every open run to the table, in slot order; none is open after.
 void VoxelGrid::end_runs() {
-  for (auto& c : cache_) {
-    if (c.key == kNoKey) continue;
-    if (queued_ == kRunBatch) drain_runs();  // add_points() may leave the queue full
-    runs_[queued_++] = Run{c.sum, c.key, slot_of(c.key, shift_)};
-    c.key = kNoKey;
+  std::uint32_t m = 0;
+  for (auto& r : open_) {
+    if (r.key == kNoKey) continue;
+    run_sums_[m] = r.sum;
+    run_keys_[m] = r.key;
+    queue_[m] = m;
+    ++m;
+    r.key = kNoKey;
   }
-  drain_runs();
+  drain_runs(m);
 }
 
 // The voxels' counts out of their float lanes into counts_, for a frame of more than exact_points_.
@@ -270,63 +291,41 @@ void VoxelGrid::finish(Cloud& out) {
   }
 }
 
-// Points [0, n) of x, y, z (with a ring each when kRings, else all in ring 0) into their voxels, kBlock keys
-// at a time. A template rather than a test of `ring` per point.
-//
-// A point goes into its ring's cache entry while the ring stays in one voxel. When it moves on, the finished
-// run (key, sums, count) is queued with its table slot, whose memory is fetched ahead; queued runs meet the
-// table in batches (drain_runs()). Branching on whether the ring stays in its voxel (72 % of the points of
-// BM_Voxel's "shed 5Hz") measured 3-7 % faster than writing the entry's run to the queue on every point
-// (BM_Voxel, g++ -O2, x86-64, busy machine; twice, in two sessions), mispredictions and all. A new run starts
-// from +0 + p, as a sum from zero does (a -0 coordinate becomes +0).
-// The queue's length, the table's pointer and shift are locals, in registers: as members, every point would
-// load and store them again (the 32-bit stores of the runs may alias them). A full block's points are
-// unrolled, each with its cache entry's byte offset and key at a fixed place in the block's arrays: a loop
-// spent about 7 of the 17 instructions of a point that stays in its voxel on its counter and indexing.
+// Points [0, n) of x, y, z (with a ring each when kRings, else all in ring 0) into their voxels, kChunk at a
+// time. A template rather than a test of `ring` per point.
 template <bool kRings>
 void VoxelGrid::add_points(const float* px, const float* py, const float* pz, const std::uint16_t* ring,
                            std::size_t n) {
-  std::uint64_t keys[kBlock];
-  simd::f32x4 points[kBlock];        // (x, y, z, 1) of each point of the block
-  std::uint16_t entry[kBlock] = {};  // byte offset of each point's cache entry
+  for (std::size_t start = 0; start < n; start += kChunk) {
+    add_chunk<kRings>(px + start, py + start, pz + start, kRings ? ring + start : nullptr, std::min(kChunk, n - start));
+  }
+}
+
+// A chunk of at most kChunk points. A ring's run of points in one voxel ends at the ring's next point in
+// another voxel (or at end_runs()); the runs meet the table in the order they ended, each summed from +0 in
+// point order, as the plain loop over the points with a running sum per ring would. That loop's test "is
+// this point in its ring's voxel" is guessed wrong about a third of the time (rings interleave point by
+// point); here the chunk's points are sorted by ring, and each ring's points summed in a register without a
+// branch, every point storing its run's running sum at its position. Then the ended runs are put back in
+// input order (each noted at the point that ended it) and drained. Measured (thread CPU time, each frame after
+// the other frames, so that the branch predictor cannot learn one: BM_VoxelAlternated): "shed 5Hz" 670 to
+// 560 us, "shed 10Hz" 350 to 300 us, "field 5Hz" (rings stay longer in a voxel) unchanged, with 65 % more
+// instructions. Before, with the branch: writing each point's ring entry to the queue in input order instead
+// (no branch, through memory) measured 3-7 % slower; two rings' sums interleaved here, no faster.
+template <bool kRings>
+void VoxelGrid::add_chunk(const float* px, const float* py, const float* pz, const std::uint16_t* ring, std::size_t n) {
+  static_assert(kChunk % kBlock == 0 && kPositions <= 0xFFFFU, "positions and point indices must fit 16 bits");
+  std::uint64_t* const keys = point_keys_.data();
+  Vec4* const points = points_.data();
+  std::uint16_t* const slot = point_slots_.data();
   float tx[kBlock] = {}, ty[kBlock] = {}, tz[kBlock] = {};
   std::uint16_t tr[kBlock] = {};
-  static_assert(sizeof(CacheEntry) * kRingCache <= 0x10000U, "cache entry offsets must fit 16 bits");
-  static_assert(kRunBatch >= kBlock);
   const KeyLanes lanes(inv_[1]);
-  auto* const cache = reinterpret_cast<unsigned char*>(cache_.data());
-  Run* const runs = runs_.data();
-  Run* next = runs + queued_;  // the queue's end
-  std::uint32_t shift = shift_;
-  const std::uint32_t* table = table_.data();
-  const auto add = [&](std::size_t j) __attribute__((always_inline)) {
-    auto& c = *reinterpret_cast<CacheEntry*>(cache + entry[j]);
-    const std::uint64_t key = keys[j];
-    if (c.key == key) [[likely]] {  // else g++ puts the miss inline and jumps to the hit and back
-      c.sum = c.sum + points[j];    // x, y, z and the count
-      return;
-    }
-    if (c.key != kNoKey) {
-      Run& r = *next++;
-      r.sum = c.sum;
-      r.key = c.key;
-      r.id = slot_of(c.key, shift);
-      __builtin_prefetch(&table[r.id]);
-    }
-    c.sum = simd::splat(0.F) + points[j];  // count 1
-    c.key = key;
-  };
+  using u16x8 = std::uint16_t __attribute__((vector_size(16)));
+  u16x8 slot_bits = {};  // every slot's bits: 1 + this is at least 1 + the highest slot
+  std::uint32_t count[kRingCache] = {};
   for (std::size_t base = 0; base < n; base += kBlock) {
     const std::size_t m = std::min(kBlock, n - base);
-    // A block queues at most a run a point: the queue is drained before it could overflow, not point by point.
-    // (Where the batches end changes no sum and no voxel id: the runs meet the table in queue order.)
-    if (next > runs + (kRunBatch - kBlock)) {
-      queued_ = static_cast<std::uint32_t>(next - runs);
-      drain_runs();  // may grow the table
-      next = runs;
-      shift = shift_;
-      table = table_.data();
-    }
     const float* bx = px + base;
     const float* by = py + base;
     const float* bz = pz + base;
@@ -344,38 +343,115 @@ void VoxelGrid::add_points(const float* px, const float* py, const float* pz, co
       }
     }
     if (coarse_) {
-      for (std::size_t j = 0; j < m; ++j) keys[j] = coarse_key(bx[j], by[j], bz[j]);
+      for (std::size_t j = 0; j < m; ++j) keys[base + j] = coarse_key(bx[j], by[j], bz[j]);
     } else {
-      block_keys(bx, by, bz, lanes, keys);
+      block_keys(bx, by, bz, lanes, keys + base);
     }
     // Four points' coordinates at a time into one vector each, by a transpose rather than point by point.
     const auto transpose = [&](std::size_t q) __attribute__((always_inline)) {
       const std::size_t b = q * 4;
       simd::f32x4 x = simd::load(bx + b), y = simd::load(by + b), z = simd::load(bz + b), w = simd::splat(1.F);
       simd::transpose4(x, y, z, w);
-      points[b] = x;
-      points[b + 1] = y;
-      points[b + 2] = z;
-      points[b + 3] = w;
+      points[base + b] = x;
+      points[base + b + 1] = y;
+      points[base + b + 2] = z;
+      points[base + b + 3] = w;
     };
     unrolled(transpose, std::make_index_sequence<kBlock / 4>{});
-    if constexpr (kRings) {  // eight rings at a time into their entries' offsets (without rings, all 0)
-      using u16x8 = std::uint16_t __attribute__((vector_size(16)));
+    if constexpr (kRings) {  // eight slots at a time
       const auto eight = [&](std::size_t q) __attribute__((always_inline)) {
         u16x8 r;
         std::memcpy(&r, br + q * 8, sizeof r);
-        r = (r & static_cast<std::uint16_t>(kRingCache - 1)) * static_cast<std::uint16_t>(sizeof(CacheEntry));
-        std::memcpy(entry + q * 8, &r, sizeof r);
+        r &= static_cast<std::uint16_t>(kRingCache - 1);
+        std::memcpy(slot + base + q * 8, &r, sizeof r);
+        slot_bits |= r;
       };
       unrolled(eight, std::make_index_sequence<kBlock / 8>{});
-    }
-    if (m == kBlock) {
-      unrolled(add, std::make_index_sequence<kBlock>{});
-    } else {
-      for (std::size_t j = 0; j < m; ++j) add(j);
+      if (m == kBlock) {
+        unrolled(
+            [&](std::size_t j) __attribute__((always_inline)) { ++count[slot[base + j]]; },
+            std::make_index_sequence<kBlock>{});
+      } else {
+        for (std::size_t j = 0; j < m; ++j) ++count[slot[base + j]];
+      }
     }
   }
-  queued_ = static_cast<std::uint32_t>(next - runs);
+  std::uint32_t slots = 1;
+  if constexpr (kRings) {
+    std::uint32_t bits = 0;
+    for (std::size_t k = 0; k < 8; ++k) bits |= slot_bits[k];
+    slots = bits + 1;
+  } else {
+    count[0] = static_cast<std::uint32_t>(n);
+  }
+  // Positions: slot by slot, one for the run the slot has open, then its points in point order.
+  std::uint32_t first[kRingCache];
+  std::uint32_t next[kRingCache];
+  std::uint32_t used = 0;
+  for (std::size_t s = 0; s < slots; ++s) {
+    first[s] = used;
+    next[s] = used + 1;
+    used += count[s] + 1;
+  }
+  std::uint16_t* const by_ring = by_ring_.data();
+  std::uint16_t* const position = positions_.data();
+  if constexpr (kRings) {
+    std::size_t i = 0;
+    const auto place = [&](std::size_t j) __attribute__((always_inline)) {
+      const std::uint32_t t = next[slot[i + j]]++;
+      by_ring[t] = static_cast<std::uint16_t>(i + j);
+      position[i + j] = static_cast<std::uint16_t>(t);
+    };
+    for (; i + 4 <= n; i += 4) unrolled(place, std::make_index_sequence<4>{});
+    for (; i < n; ++i) place(0);
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      by_ring[i + 1] = static_cast<std::uint16_t>(i);
+      position[i] = static_cast<std::uint16_t>(i + 1);
+    }
+  }
+  // Each slot's runs: every position stores its run's running sum and key; a point in another voxel than the
+  // one before it ends the run at the position before its own, and restarts the sum from +0 (the lanes masked
+  // to +0, then + p: as a sum from zero, a -0 coordinate becomes +0).
+  Vec4* const run_sums = run_sums_.data();
+  std::uint64_t* const run_keys = run_keys_.data();
+  std::uint8_t* const ended = ended_.data();
+  using I = simd::i32x4;
+  static constexpr I kKeep[2] = {I{-1, -1, -1, -1}, I{0, 0, 0, 0}};  // by "moved on"
+  for (std::size_t s = 0; s < slots; ++s) {
+    const std::uint32_t c = count[s];
+    if (c == 0) continue;
+    std::uint32_t t = first[s];
+    Vec4 sum = open_[s].sum;
+    std::uint64_t prev = open_[s].key;
+    run_sums[t] = sum;
+    run_keys[t] = prev;
+    const std::uint32_t end = t + 1 + c;
+    for (++t; t < end; ++t) {
+      const std::uint32_t i = by_ring[t];
+      const std::uint64_t key = keys[i];
+      const bool moved = key != prev;
+      ended[i] = static_cast<std::uint8_t>(moved);
+      sum = std::bit_cast<Vec4>(std::bit_cast<I>(sum) & kKeep[moved]) + points[i];
+      run_sums[t] = sum;
+      run_keys[t] = key;
+      prev = key;
+    }
+    if (open_[s].key == kNoKey) ended[by_ring[first[s] + 1]] = 0;  // the slot's first run ended none
+    open_[s].sum = sum;
+    open_[s].key = prev;
+  }
+  // The ended runs in the order they ended (point order), then into their voxels.
+  std::uint32_t* const queue = queue_.data();
+  std::uint32_t queued = 0;
+  std::size_t i = 0;
+  const auto note = [&](std::size_t j) __attribute__((always_inline)) {
+    queue[queued] = position[i + j] - 1U;
+    queued += ended[i + j];
+  };
+  for (; i + 4 <= n; i += 4) unrolled(note, std::make_index_sequence<4>{});
+  for (; i < n; ++i) note(0);
+  drain_runs(queued);
 }
 
 void VoxelGrid::filter(const Cloud& in, Cloud& out) {

@@ -98,6 +98,41 @@ TEST(VoxelGrid, CoarserLeafWithRange) {
   EXPECT_EQ(out.size(), 7U);
 }
 
+// The coarse keys (one per point, not four at a time) through the ring sort, across chunks and a block's tail:
+// with rings the same voxels and centroids (up to the order of the float sums) as without.
+TEST(VoxelGrid, CoarserLeafWithRingsAcrossChunks) {
+  testing::TestRng rng{37};
+  Cloud with_rings, without;
+  for (int i = 0; i < 3001; ++i) {
+    const float a = rng.uniform(-3.F, 3.F), r = rng.uniform(2.F, 45.F);
+    const float x = r * std::cos(a), y = r * std::sin(a), z = rng.uniform(-1.F, 2.F);
+    with_rings.push_back(x, y, z, static_cast<std::uint16_t>(i % 32));
+    without.push_back(x, y, z);
+  }
+  VoxelGrid a(VoxelParams{0.1, 10.0, 0.3}), b(VoxelParams{0.1, 10.0, 0.3});
+  Cloud oa, ob;
+  a.filter(with_rings, oa);
+  b.filter(without, ob);
+  // The voxels, written plainly: band max(1, floor(r / 10)) up to 3, leaf min(0.1 * band, 0.3).
+  using Key = std::tuple<int, int, int, int>;
+  const auto voxel = [](float x, float y, float z) {
+    const float r = std::sqrt(x * x + y * y) * static_cast<float>(1.0 / 10.0);
+    const int band = r >= 3.F ? 3 : std::max(1, static_cast<int>(r));
+    const float inv = 1.0F / static_cast<float>(std::min(0.1 * band, 0.3));
+    return Key{band, static_cast<int>(std::floor(x * inv)), static_cast<int>(std::floor(y * inv)),
+               static_cast<int>(std::floor(z * inv))};
+  };
+  std::map<Key, int> want;
+  for (std::size_t i = 0; i < without.size(); ++i) ++want[voxel(without.x[i], without.y[i], without.z[i])];
+  ASSERT_EQ(oa.size(), want.size());
+  ASSERT_EQ(ob.size(), want.size());
+  ASSERT_LT(want.size(), with_rings.size());  // some points share a voxel
+  const auto pa = sorted(points_of(oa)), pb = sorted(points_of(ob));
+  for (std::size_t i = 0; i < pa.size(); ++i) {
+    for (std::size_t k = 0; k < 3; ++k) ASSERT_NEAR(pa[i][k], pb[i][k], 1e-4F) << i;
+  }
+}
+
 TEST(VoxelGrid, EmptyInputAndReuseAcrossFrames) {
   VoxelGrid grid(VoxelParams{});
   Cloud in, out;
@@ -279,10 +314,53 @@ TEST(VoxelGrid, SameBitsAndOrderAsThePlainRunContract) {
   }
 }
 
+// The grid sorts a chunk of points (1024) by ring at a time and sums each ring's runs without a branch: bit
+// for bit and in order as the plain contract, whatever the rings' shares, numbers and reach across chunks.
+// Frames that end in every place around a chunk and a 16-point block; one ring carrying nine tenths of the
+// points; one ring staying in one voxel across chunks; rings that appear only in a later chunk, rings that
+// share a slot (0, 128 and 256; 127 and 65535), a single ring, and no rings.
+TEST(VoxelGrid, ChunkedRingSortKeepsThePlainRunContract) {
+  testing::TestRng rng{31};
+  const auto shape = [&](std::size_t n, int kind) {
+    Cloud c;
+    for (std::size_t i = 0; i < n; ++i) {
+      const float a = static_cast<float>(i) * 0.002F;
+      std::uint16_t ring = static_cast<std::uint16_t>(rng.next() % 32);
+      float r = 3.F + 10.F * std::fabs(std::sin(0.7F * static_cast<float>(ring) + a)) + rng.uniform(0.F, 0.05F);
+      if (kind == 1) ring = rng.uniform(0.F, 1.F) < 0.9F ? std::uint16_t{0} : ring;
+      if (kind == 2 && ring == 7) r = 5.01F;  // ring 7: one voxel from the first point to the last
+      if (kind == 3) ring = i < n / 2 ? static_cast<std::uint16_t>(ring % 4) : ring;  // rings 4-31 start late
+      if (kind == 4) ring = std::array<std::uint16_t, 5>{0, 128, 256, 127, 65535}[ring % 5];
+      if (kind == 5) ring = 9;
+      const float z = kind == 2 && ring == 7 ? 0.01F : -1.F + 0.1F * static_cast<float>(ring % 32);
+      c.push_back(r * std::cos(a), r * std::sin(a), z + rng.uniform(-0.02F, 0.02F), ring);
+    }
+    if (kind == 6) c.ring.clear();
+    return c;
+  };
+  VoxelGrid grid(VoxelParams{0.15, 0.0, 0.45});
+  for (int kind = 0; kind < 7; ++kind) {
+    for (const std::size_t n : {std::size_t{1}, std::size_t{17}, std::size_t{1023}, std::size_t{1024},
+                                std::size_t{1025}, std::size_t{2049}, std::size_t{5000}}) {
+      const Cloud c = shape(n, kind);
+      const std::vector<P3> want = reference_centroids(c, 0.15F);
+      Cloud out;
+      grid.filter(c, out);
+      ASSERT_EQ(out.size(), want.size()) << kind << " " << n;
+      for (std::size_t v = 0; v < want.size(); ++v) {
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(out.x[v]), std::bit_cast<std::uint32_t>(want[v][0])) << kind << " " << n;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(out.y[v]), std::bit_cast<std::uint32_t>(want[v][1])) << kind << " " << n;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(out.z[v]), std::bit_cast<std::uint32_t>(want[v][2])) << kind << " " << n;
+      }
+    }
+  }
+}
+
 // Counts are summed in float lanes, exact below 2^24 points: a larger frame is taken in pieces, the counts
-// moved to integers between them. Pieces of a few hundred points here (tails of blocks, runs open across the
-// cut, voxels met again in later pieces, a frame after): coordinates in eighths (leaf 0.5), whose sums are
-// exact in any order, so the centroids must be the one-piece centroids exactly.
+// moved to integers between them. Pieces of 16 to 2051 points here (tails of blocks and of the grid's
+// 1024-point chunks, runs open across the cut, voxels met again in later pieces, a frame after): coordinates
+// in eighths (leaf 0.5), whose sums are exact in any order, so the centroids must be the one-piece centroids
+// exactly.
 TEST(VoxelGrid, FramesTakenInPiecesKeepTheirCounts) {
   testing::TestRng rng{29};
   Cloud in;
@@ -294,7 +372,7 @@ TEST(VoxelGrid, FramesTakenInPiecesKeepTheirCounts) {
   Cloud want;
   whole.filter(in, want);
   ASSERT_GT(want.size(), 100U);
-  for (const std::size_t piece : {std::size_t{777}, std::size_t{16}}) {
+  for (const std::size_t piece : {std::size_t{777}, std::size_t{16}, std::size_t{1500}, std::size_t{2051}}) {
     VoxelGrid grid(VoxelParams{0.5, 0.0, 0.5}, piece);
     for (int frame = 0; frame < 2; ++frame) {
       Cloud out;

@@ -5,11 +5,12 @@
 //
 // Fast: voxel keys packed in 64 bits, in a flat open-addressing hash table of 4-byte voxel ids (linear
 // probing, at most a quarter full; ids offset per frame, so nothing is cleared between frames; small, so that
-// it stays in cache while the rotation streams past); in front of it a per-ring cache of the last
-// voxel with its running sums (a ring's consecutive returns usually share a voxel: 72-85 % of an HDL-32E
-// rotation's points, by scene, never reach the table); finished runs meet the table in batches, with the memory they
-// need fetched ahead. Output in the order the voxels' first runs finished, which, as every sum's order,
-// depends only on the input: deterministic.
+// it stays in cache while the rotation streams past). A ring's consecutive returns usually share a voxel
+// (72-85 % of an HDL-32E rotation's points, by scene): the points are taken a chunk at a time, sorted by ring,
+// and each ring's runs of points in one voxel summed without a branch per point (a sensor's rings interleave
+// point by point, and whether a ring stays in its voxel is guessed wrong about a third of the time); only the
+// runs meet the table, in the order they ended in the input. Output in the order the voxels' first runs ended,
+// which, as every sum's order, depends only on the input: deterministic.
 // Thread-compatible: one VoxelGrid per thread (it owns its scratch).
 
 #include <array>
@@ -36,22 +37,20 @@ class VoxelGrid {
 
  private:
   using Vec4 = vec4::f32x4;
-  struct CacheEntry {
-    Vec4 sum;  // x, y, z, count
+  struct OpenRun {  // a ring's points in one voxel since the ring's last move, not yet ended
+    Vec4 sum;       // x, y, z, count
     std::uint64_t key;
   };
-  struct Run {  // a ring's points in one voxel, waiting for the table
-    Vec4 sum;   // x, y, z, count
-    std::uint64_t key;
-    std::uint32_t id;  // the key's first table slot
-  };
-  static constexpr std::size_t kRingCache = 128;
-  static constexpr std::uint32_t kRunBatch = 64;
+  static constexpr std::size_t kRingCache = 128;  // rings are told apart modulo this
+  static constexpr std::size_t kChunk = 1024;     // points sorted by ring at a time
+  static constexpr std::size_t kPositions = kChunk + kRingCache;
 
   void begin(std::size_t max_points);
   template <bool kRings>
   void add_points(const float* x, const float* y, const float* z, const std::uint16_t* ring, std::size_t n);
-  void drain_runs();
+  template <bool kRings>
+  void add_chunk(const float* x, const float* y, const float* z, const std::uint16_t* ring, std::size_t n);
+  void drain_runs(std::uint32_t queued);
   void end_runs();
   void fold_counts();
   void finish(Cloud& out);
@@ -74,9 +73,21 @@ class VoxelGrid {
   std::uint32_t counted_ = 0;
   Buffer<std::uint64_t> keys_;  // key of each voxel id, for growing the table
   std::uint32_t voxels_ = 0;
-  std::array<CacheEntry, kRingCache> cache_{};
-  std::array<Run, kRunBatch> runs_{};
-  std::uint32_t queued_ = 0;
+  std::array<OpenRun, kRingCache> open_{};  // by ring & (kRingCache - 1)
+  // Scratch of one chunk. By point: (x, y, z, 1), key, ring slot, position in by_ring_, and whether the point
+  // ended its ring's run. By position (each slot's points in point order, after one position for the run the
+  // slot had open): the point, and the running sum and key of its run. The ended runs (their last positions) in
+  // the order they ended, with their table slots.
+  Buffer<Vec4> points_;
+  Buffer<std::uint64_t> point_keys_;
+  Buffer<std::uint16_t> point_slots_;
+  Buffer<std::uint16_t> positions_;
+  Buffer<std::uint8_t> ended_;
+  Buffer<std::uint16_t> by_ring_;
+  Buffer<Vec4> run_sums_;
+  Buffer<std::uint64_t> run_keys_;
+  Buffer<std::uint32_t> queue_;
+  Buffer<std::uint32_t> queue_slots_;
 };
 
 }  // namespace fieldguard::perception
