@@ -451,6 +451,33 @@ void BM_ClusterAnisotropicGrid(benchmark::State& state) {
       },
       [&] { pcl_clusters(f.pcl_above, 0.6, 1, 1000000); });
 }
+// fieldguard.yaml's clustering on the points the fieldguard.yaml pipeline clusters (its crop with the ground
+// context, voxel grid and ground zones; not ground, not beyond the ROI): the input BM_PacketsToObstacles times.
+void BM_ClusterPipelineInput(benchmark::State& state) {
+  Frame& f = frame(static_cast<int>(state.range(0)));
+  const PipelineParams& p = fieldguard_params();
+  Box3 roi = p.roi;
+  roi.max[0] += p.ground.context_m;
+  Cloud cropped, voxels, above;
+  crop_box(f.points, roi, p.body, cropped);
+  VoxelGrid(p.voxel).filter(cropped, voxels);
+  GroundLabels labels;
+  ZoneGround(p.ground.zones).segment(voxels, labels);
+  const auto far = static_cast<float>(p.roi.max[0]);
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    if (labels.ground[i] == 0U && !(voxels.x[i] > far)) above.push_back(voxels.x[i], voxels.y[i], voxels.z[i]);
+  }
+  EuclideanClusterer clusterer(p.cluster);
+  Clusters out;
+  paired(
+      state, "cluster: fieldguard.yaml, pipeline input", static_cast<int>(state.range(0)), above.size(),
+      [&] {
+        clusterer.extract(above, out);
+        benchmark::DoNotOptimize(out.indices.data());
+      },
+      {});
+  state.counters["clusters"] = static_cast<double>(out.size());
+}
 void BM_ClusterAbsorb(benchmark::State& state) {
   Frame& f = frame(static_cast<int>(state.range(0)));
   const ClusterParams cp = fieldguard_params().cluster;
@@ -748,6 +775,7 @@ FG_BENCH(BM_ClusterFixedKdTree);
 FG_BENCH(BM_ClusterFixedGrid);
 FG_BENCH(BM_ClusterAdaptiveGrid);
 FG_BENCH(BM_ClusterAnisotropicGrid);
+FG_BENCH(BM_ClusterPipelineInput);
 FG_BENCH(BM_ClusterAbsorb);
 FG_BENCH(BM_ClusterJoin);
 FG_BENCH(BM_ClusterSplit);

@@ -425,6 +425,65 @@ TEST(EuclideanClusterer, FarTallCellsStayExact) {
   }
 }
 
+// The grid joins column by column, and passes over a pair of columns each wholly in one cluster, the same one. A
+// column whose cells are in two clusters (two clumps 4 m apart one above the other) joins both through a vertical
+// chain of points in the column beside it, before it in cell order or after it; without the chain they stay
+// apart. And random towers of such clumps, some of them chained: the k-d tree's clusters.
+TEST(EuclideanClusterer, GridColumnsSplitInHeightJoinThroughTheirNeighbours) {
+  const auto clumps = [](Cloud& c, float x) {
+    for (int i = 0; i < 3; ++i) c.push_back(x, 0.05F, 0.1F * static_cast<float>(i));
+    for (int i = 0; i < 3; ++i) c.push_back(x, 0.05F, 4.F + 0.1F * static_cast<float>(i));
+  };
+  const auto chain = [](Cloud& c, float x) {
+    for (int i = 0; i <= 28; ++i) c.push_back(x, 0.05F, 0.15F * static_cast<float>(i));
+  };
+  for (const auto method : {ClusterMethod::Fixed, ClusterMethod::Adaptive, ClusterMethod::Anisotropic}) {
+    for (const float chain_dx : {-0.25F, 0.25F, 0.F}) {  // 0: no chain
+      Cloud c;
+      clumps(c, 10.F);
+      if (chain_dx != 0.F) chain(c, 10.F + chain_dx);
+      for (const auto structure : {ClusterStructure::KdTree, ClusterStructure::Grid}) {
+        EuclideanClusterer e(params(method, structure, 0.4));
+        Clusters out;
+        e.extract(c, out);
+        EXPECT_EQ(out.size(), chain_dx != 0.F ? 1U : 2U)
+            << method_name(method) << " chain " << chain_dx << (structure == ClusterStructure::Grid ? " grid" : " kd");
+      }
+    }
+    testing::TestRng rng{59};
+    Cloud c;
+    for (int t = 0; t < 300; ++t) {
+      const float x = rng.uniform(4, 30), y = rng.uniform(-6, 6);
+      const int levels = 1 + t % 4;
+      for (int l = 0; l < levels; ++l) {
+        const float z = rng.uniform(-1.5F, 6.F);
+        for (int i = 0; i < 4; ++i) {
+          c.push_back(x + rng.uniform(-0.1F, 0.1F), y + rng.uniform(-0.1F, 0.1F), z + 0.1F * static_cast<float>(i));
+        }
+      }
+      if (t % 3 == 0) {
+        const float cx = x + rng.uniform(-0.5F, 0.5F), cy = y + rng.uniform(-0.5F, 0.5F);
+        for (int i = 0; i < 40; ++i) c.push_back(cx, cy, -1.5F + 0.2F * static_cast<float>(i));
+      }
+    }
+    // Lone columns of a few points each (a column's cells below a cell may be in several clusters, which the
+    // cell may join at once: its nearest one below must not end the look).
+    for (int t = 0; t < 400; ++t) {
+      const float x = 4.F + 3.F * static_cast<float>(t % 10), y = -30.F + 3.F * static_cast<float>(t / 10);
+      for (int i = 0; i < 6; ++i) {
+        c.push_back(x + rng.uniform(0.F, 0.2F), y + rng.uniform(0.F, 0.2F), rng.uniform(0.F, 2.5F));
+      }
+    }
+    Clusters a, b;
+    EuclideanClusterer kd(params(method, ClusterStructure::KdTree, 0.4));
+    EuclideanClusterer grid(params(method, ClusterStructure::Grid, 0.4));
+    kd.extract(c, a);
+    grid.extract(c, b);
+    EXPECT_GT(a.size(), 50U) << method_name(method);
+    EXPECT_EQ(sets_of(a), sets_of(b)) << method_name(method);
+  }
+}
+
 // The grid passes over a column with no cell below the looking cell in the radii order. That column's lowest cell
 // may be mid-column (its point nearest the sensor), not its first: a point in the next column beside a column
 // 20 m out, nearer than the column's bottom point and farther than its middle one, joins the middle one; bottom

@@ -11,7 +11,8 @@
 // tree, the published way) or Grid (cells small enough that a cell's points always join: cubes, stacked into taller
 // cells far out where the radii allow; union-find over cells, each cell looking back at the cells before it within
 // a stencil that covers both sides' radii, so each pair is looked at once, nearest first, and joined by their first
-// pair within reach, tested four at a time). Both find exactly the same clusters.
+// pair within reach, tested four at a time; column by column, a pair of columns each wholly in the same cluster
+// passed over whole). Both find exactly the same clusters.
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
 
@@ -91,7 +92,6 @@ class EuclideanClusterer {
   Buffer<float> r2_;     // per point (adaptive): its radius squared
   Buffer<float> h2_;     // per point (anisotropic): its horizontal radius squared
   Buffer<float> query_;  // per point: the search radius that finds every neighbour
-  Buffer<float> range_;  // per point (grid, adaptive): its 3D range
   Buffer<std::uint8_t> done_;
   Buffer<std::uint32_t> queue_;
   Buffer<std::uint32_t> pos_of_;  // cloud index -> position in the structure's order (grid: its cell)
@@ -103,12 +103,13 @@ class EuclideanClusterer {
   Buffer<std::uint32_t> by_z_;        // point indices in z order
   Buffer<std::uint32_t> grid_index_;  // grid order -> point index
   Buffer<float> grid_xyz_;            // x, y, z, vertical and horizontal radius squared in grid order, one array each
+  Buffer<float> grid_point_;          // x, y, z and 3D range (adaptive) of each point in grid order, side by side
+  Buffer<std::uint32_t> grid_z_;      // z cell in grid order
   struct Cell {
     std::uint32_t first;   // its points: grid order [first, next cell's first)
     std::uint32_t col;     // x-y column
     float reach2;          // the largest radius of its points, squared (anisotropic: the vertical one)
     float hreach2;         // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
-    float range;           // adaptive: the 3D range of its farthest point
   };
   static constexpr std::uint32_t kNoCluster = 0xFFFFFFFFU;
   Buffer<Cell> cells_;
@@ -117,8 +118,14 @@ class EuclideanClusterer {
     std::uint32_t iz_top;  // its highest z cell (far out a cell stacks several: see extract_grid)
   };
   Buffer<ZSpan> cell_z_;
-  Buffer<float> cell_box_;           // per cell, the box of its points (min x, y, z, max x, y, z)
+  Buffer<float> cell_box_;           // per cell, the box of its points (min x, y, z, -, max x, y, z, range)
   Buffer<std::uint32_t> col_cells_;  // per column: its first cell (cells of a column ascend in z)
+  struct Stencil {  // per cell: the cells it looks at (extract_grid)
+    std::uint32_t hreach;  // columns apart on x and on y
+    std::uint32_t z_lo, z_hi;  // z cells
+  };
+  Buffer<Stencil> stencil_;
+  Buffer<std::uint32_t> col_rep_;    // per column, once its joins are done: a cell of it if all are in one cluster
   Buffer<std::uint32_t> parent_;     // union-find over cells
   Buffer<std::uint32_t> root_size_;  // per root cell: its cluster's size
   Buffer<std::uint32_t> cluster_of_root_;
