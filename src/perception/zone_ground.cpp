@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "perception/hypot.hpp"
+#include "perception/nth_element.hpp"
 #include "perception/simd.hpp"
 
 namespace fieldguard::perception {
@@ -214,7 +215,12 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   tmp_.resize(pts_.padded);
   residuals(slope, tmp_.data());  // the padding's too, past m: never looked at
   const std::size_t lowest = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(params_.seed_lowest, 1)), 1, m);
-  std::nth_element(tmp_.begin(), tmp_.begin() + static_cast<std::ptrdiff_t>(lowest - 1), tmp_.end());
+  const auto padded = static_cast<std::uint32_t>(pts_.padded);
+  select_scratch_.resize(2 * std::size_t{padded} + 2);
+  if (!nth_element_branchfree(tmp_.data(), padded, static_cast<std::uint32_t>(lowest - 1), select_scratch_.data())) {
+    residuals(slope, tmp_.data());  // libstdc++ heap-selects here: its own call, on the residuals again
+    std::nth_element(tmp_.begin(), tmp_.begin() + static_cast<std::ptrdiff_t>(lowest - 1), tmp_.end());
+  }
   float sum = 0.F;
   for (std::size_t i = 0; i < lowest; ++i) sum += tmp_[i];
   const float seed_hi = sum / static_cast<float>(lowest) + static_cast<float>(params_.seed_margin_m);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
 #include "perception/hypot.hpp"
+#include "perception/nth_element.hpp"
 #include "perception/test_clouds.hpp"
 
 namespace fieldguard::perception {
@@ -435,6 +437,107 @@ TEST(ZoneGround, LabelsFourAtATimeAsOneAtATime) {
         EXPECT_EQ(blended, 0U);
       }
     }
+  }
+}
+
+// Values for which libstdc++'s nth_element(v, v + nth, v + n) runs out of partitions and heap-selects: McIlroy's
+// adversary ("A killer adversary for quicksort"), mirrored. Every value starts as "gas" (below everything solid);
+// when two gas values meet, one of them freezes to the next solid value, each one lower than the last, so the
+// pivots come out near the top and each partition cuts off a few elements at the top only.
+std::vector<float> nth_element_killer(std::uint32_t n, std::uint32_t nth) {
+  std::vector<std::uint32_t> val(n, 0), ids(n);
+  for (std::uint32_t i = 0; i < n; ++i) ids[i] = i;
+  std::uint32_t solid = 2 * n, candidate = 0;
+  std::nth_element(ids.begin(), ids.begin() + nth, ids.end(), [&](std::uint32_t x, std::uint32_t y) {
+    if (val[x] == 0 && val[y] == 0) val[x == candidate ? x : y] = solid--;
+    if (val[x] == 0) {
+      candidate = x;
+    } else if (val[y] == 0) {
+      candidate = y;
+    }
+    return val[x] < val[y];
+  });
+  std::vector<float> v(n);  // the same order, in metres about the ground
+  for (std::uint32_t i = 0; i < n; ++i) v[i] = -1.F + 0.0005F * static_cast<float>(val[i]);
+  return v;
+}
+
+// The seeds' height is the sum of a bin's lowest residuals in the order std::nth_element leaves them:
+// nth_element_branchfree must leave every element where libstdc++ does, or the sum and the planes change. Arrays of
+// every size up to 300, with ties, NaN, signed zeros and infinities, sorted and not, every nth.
+TEST(ZoneGround, NthElementBranchFreeMovesElementsAsTheLibrary) {
+  testing::TestRng rng(5);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const auto same = [](const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+  };
+  std::vector<std::uint32_t> scratch;
+  std::size_t gave_up = 0;
+  for (int run = 0; run < 60000; ++run) {
+    const auto n = static_cast<std::uint32_t>(run % 3 == 0 ? rng.next() % 301 : rng.next() % 24);
+    std::vector<float> v(n);
+    const int kind = run % 5;
+    for (float& x : v) {
+      const auto u = static_cast<std::uint32_t>(rng.next() >> 32U);
+      switch (kind) {
+        case 0: x = rng.uniform(-2.F, 2.F); break;
+        case 1: x = static_cast<float>(u % 4U); break;  // many ties
+        case 2: x = u % 40U == 0 ? nan : static_cast<float>(u % 8U) - 3.F; break;
+        case 3: {
+          const float odd[] = {0.F, -0.F, inf, -inf, 1.F, -1.F, 1e6F};
+          x = odd[u % 7U];
+          break;
+        }
+        default: x = rng.uniform(-1.F, 1.F); break;
+      }
+    }
+    if (kind == 4 && run % 2 == 0) std::sort(v.begin(), v.end());
+    if (kind == 4 && run % 2 == 1) std::sort(v.rbegin(), v.rend());
+    const std::uint32_t nth = n == 0 ? 0 : static_cast<std::uint32_t>(rng.next() % n);
+    std::vector<float> ours = v, lib = v;
+    scratch.assign(2 * std::size_t{n} + 2, 0);
+    const bool done = nth_element_branchfree(ours.data(), n, nth, scratch.data());
+    std::nth_element(lib.begin(), lib.begin() + nth, lib.end());
+    if (!done) {
+      ++gave_up;
+      continue;
+    }
+    ASSERT_TRUE(same(ours, lib)) << "run " << run << ", n " << n << ", nth " << nth;
+  }
+  EXPECT_LT(gave_up, 10U);
+  // Where libstdc++ heap-selects, this one says so instead of answering.
+  for (const std::uint32_t n : {32U, 64U, 256U}) {
+    std::vector<float> v = nth_element_killer(n, 9);
+    scratch.assign(2 * std::size_t{n} + 2, 0);
+    EXPECT_FALSE(nth_element_branchfree(v.data(), n, 9, scratch.data())) << n;
+  }
+}
+
+// A bin whose residuals make libstdc++ heap-select (the branch-free selection gives up): the zone ground selects its
+// seeds with std::nth_element on the residuals again, and the bin gets its plane like any other.
+TEST(ZoneGround, ABinTheSelectionGivesUpOnStillGetsItsPlane) {
+  // 64 points in one bin of the first zone's outer ring (4 to 6 m, the sector from 0 to 22.5 degrees), heights in
+  // the killer's order; nothing nearer, so the bin's prior is level (slope 0): its residuals are its heights.
+  const std::vector<float> z = nth_element_killer(64, 9);
+  Cloud c;
+  for (std::uint32_t i = 0; i < 64; ++i) {
+    const float r = 4.2F + 0.2F * static_cast<float>(i % 8U), a = 0.04F + 0.04F * static_cast<float>(i / 8U);
+    c.push_back(r * std::cos(a), r * std::sin(a), z[i]);
+  }
+  std::vector<float> residuals = z;
+  std::vector<std::uint32_t> scratch(2 * 64 + 2);
+  ASSERT_FALSE(nth_element_branchfree(residuals.data(), 64, 9, scratch.data()));  // the case under test
+
+  ZoneGround zones(ZoneParams{});
+  GroundLabels labels, one;
+  zones.segment(c, labels);
+  for (std::size_t i = 0; i < c.size(); ++i) ASSERT_EQ(zones.bin_of(c.x[i], c.y[i]), zones.bin_of(c.x[0], c.y[0]));
+  EXPECT_TRUE(zones.fitted_at(5.F, 0.2F));
+  EXPECT_NEAR(zones.ground_z(5.F, 0.2F), -0.96F, 0.03F);
+  zones.label_one_at_a_time(c, one);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(labels.ground[i], 1U) << i;
+    EXPECT_EQ(std::memcmp(&labels.height_m[i], &one.height_m[i], sizeof(float)), 0) << i;
   }
 }
 

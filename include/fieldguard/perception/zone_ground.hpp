@@ -120,8 +120,9 @@ class ZoneGround {
   Buffer<std::uint32_t> bin_start_;  // per bin (and one past the last): where its run starts in sx_ .. sz_
   Buffer<std::uint32_t> cursor_;
   Buffer<float> sx_, sy_, sz_;
-  Buffer<std::uint32_t> sidx_;  // per sorted point: its index in the cloud (padding: unset)
-  Buffer<float> bx_, by_, bz_, tmp_;  // the innermost ring's points (padded), and scratch
+  Buffer<std::uint32_t> sidx_;            // per sorted point: its index in the cloud (padding: unset)
+  Buffer<float> bx_, by_, bz_, tmp_;      // the innermost ring's points (padded), and scratch
+  Buffer<std::uint32_t> select_scratch_;  // nth_element_branchfree's
   // The points least_squares and fit_bin look at: one bin's run, or the innermost ring's.
   struct Points {
     const float* x = nullptr;
