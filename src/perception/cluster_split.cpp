@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
+#include "perception/indices.hpp"
 #include "perception/simd.hpp"
 
 namespace fieldguard::perception {
@@ -65,6 +67,10 @@ bool ClusterSplitter::find_cut(const Cloud& cloud, const EuclideanClusterer& clu
     }
   }
   if (t_hi - t_lo < static_cast<float>(params_.min_length_m)) return false;
+  // A cluster spanning most of the float range (nothing a sensor returns) overflows its projections: left whole.
+  // Otherwise every projection is finite (the largest and least are at corners), so every slot's least and
+  // greatest are reached by a member.
+  if (!std::isfinite(t_hi - t_lo)) return false;
 
   // Slots along the axis no wider than the narrowest gap that can count (no radius is below tolerance_m): two
   // projections in one slot are never a gap, so the gaps between occupied slots are all the gaps there are
@@ -75,24 +81,57 @@ bool ClusterSplitter::find_cut(const Cloud& cloud, const EuclideanClusterer& clu
   const float inv_width = 1.F / width;
   const auto slots = std::min<std::size_t>(kMaxSlots, static_cast<std::size_t>((t_hi - t_lo) * inv_width) + 1);
   const auto last_slot = static_cast<float>(slots - 1);
-  slots_.assign(slots, Slot{0U, 0.F, 0.F, 0U, 0U});
+  // Each slot's least and greatest projection only; the points reaching them are looked for after, in the rare
+  // cluster with a gap worth weighing (keeping them here, a branch per point, took a third of this loop).
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  slots_.assign(slots, Slot{0U, kInf, -kInf, kNone, kNone});
+  const auto slot_of = [&](float t) {
+    // As std::clamp to [0, last_slot] (a -0 gives slot 0 either way).
+    return static_cast<std::size_t>(
+        static_cast<std::int32_t>(std::min(std::max(0.F, (t - t_lo) * inv_width), last_slot)));
+  };
+  const auto add = [&](float t, std::int32_t s) {
+    Slot& slot = slots_[static_cast<std::size_t>(s)];
+    ++slot.count;
+    slot.lo = std::min(slot.lo, t);
+    slot.hi = std::max(slot.hi, t);
+  };
   t_.resize(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::uint32_t i = members[k];
-    const float t = (cloud.x[i] - mx) * ax + (cloud.y[i] - my) * ay;
-    t_[k] = t;
-    const float q = std::clamp((t - t_lo) * inv_width, 0.F, last_slot);
-    Slot& slot = slots_[static_cast<std::size_t>(q)];
-    if (slot.count++ == 0) {
-      slot.lo = slot.hi = t;
-      slot.lo_i = slot.hi_i = i;
-    } else if (t < slot.lo) {
-      slot.lo = t;
-      slot.lo_i = i;
-    } else if (t > slot.hi) {
-      slot.hi = t;
-      slot.hi_i = i;
+  const float* const px = cloud.x.data();
+  const float* const py = cloud.y.data();
+  std::size_t k = 0;
+  {
+    // Four members a turn, their projections and slots lane by lane as slot_of's (the same operations in the same
+    // order: the same bits), a run of four points loaded as vectors (most of a cluster's members are runs).
+    const simd::f32x4 vmx = simd::splat(mx), vmy = simd::splat(my), vax = simd::splat(ax), vay = simd::splat(ay);
+    const simd::f32x4 lo = simd::splat(t_lo), inv = simd::splat(inv_width), zero = simd::splat(0.F),
+                      top = simd::splat(last_slot);
+    const bool run_safe = cloud.size() < kRunSafe;  // every member is below the cloud's size (split checked)
+    for (; k + 4 <= m; k += 4) {
+      simd::f32x4 x, y;
+      if (run_safe && run_of_four(members.data() + k)) {
+        x = simd::load(px + members[k]);
+        y = simd::load(py + members[k]);
+      } else {
+        const std::uint32_t i0 = members[k], i1 = members[k + 1], i2 = members[k + 2], i3 = members[k + 3];
+        x = simd::f32x4{px[i0], px[i1], px[i2], px[i3]};
+        y = simd::f32x4{py[i0], py[i1], py[i2], py[i3]};
+      }
+      const simd::f32x4 t = (x - vmx) * vax + (y - vmy) * vay;
+      std::memcpy(t_.data() + k, &t, sizeof t);
+      const simd::i32x4 s =
+          __builtin_convertvector(simd::min_or_bound(simd::max_or_bound((t - lo) * inv, zero), top), simd::i32x4);
+      add(t[0], s[0]);
+      add(t[1], s[1]);
+      add(t[2], s[2]);
+      add(t[3], s[3]);
     }
+  }
+  for (; k < m; ++k) {
+    const std::uint32_t i = members[k];
+    const float t = (px[i] - mx) * ax + (py[i] - my) * ay;
+    t_[k] = t;
+    add(t, static_cast<std::int32_t>(slot_of(t)));
   }
   float front = 0.F, back = 0.F;
   for (const Slot& slot : slots_) {
@@ -117,26 +156,52 @@ bool ClusterSplitter::find_cut(const Cloud& cloud, const EuclideanClusterer& clu
   const auto range_of = [&cloud](std::uint32_t i) {
     return std::sqrt(cloud.x[i] * cloud.x[i] + cloud.y[i] * cloud.y[i] + cloud.z[i] * cloud.z[i]);
   };
+  // Whether a gap between two occupied slots passes the tests that need no range.
+  const auto may_cut = [&](const Slot& left, const Slot& right, float first, float end, std::size_t before) {
+    const std::size_t after = m - before;
+    return right.lo - left.hi >= gap_floor && before >= share && after >= share && left.hi - first >= min_part_m &&
+           end - right.lo >= min_part_m;
+  };
+  {
+    bool any = false;
+    std::size_t before = 0;
+    const Slot* last = nullptr;
+    for (const Slot& slot : slots_) {
+      if (slot.count == 0) continue;
+      if (last != nullptr && may_cut(*last, slot, front, back, before)) {
+        any = true;
+        break;
+      }
+      before += slot.count;
+      last = &slot;
+    }
+    if (!any) return false;
+  }
+  // The first member (in the order of `members`) reaching each slot's least and greatest projection: a gap's
+  // range is taken at those two points.
+  for (k = 0; k < m; ++k) {
+    const float t = t_[k];
+    Slot& slot = slots_[slot_of(t)];
+    if (slot.lo_i == kNone && t == slot.lo) slot.lo_i = members[k];
+    if (slot.hi_i == kNone && t == slot.hi) slot.hi_i = members[k];
+  }
   bool found = false;
   float best_ratio = 0.F;
   std::size_t before = 0;  // points up to the last occupied slot
   const Slot* last = nullptr;
   for (const Slot& slot : slots_) {
     if (slot.count == 0) continue;
-    if (last != nullptr) {
-      const float gap = slot.lo - last->hi;
+    if (last != nullptr && may_cut(*last, slot, front, back, before)) {
       const std::size_t after = m - before;
-      if (gap >= gap_floor && before >= share && after >= share && last->hi - front >= min_part_m &&
-          back - slot.lo >= min_part_m) {
-        const float r = 0.5F * (range_of(last->hi_i) + range_of(slot.lo_i));
-        const float scale = r > full ? (full / r) * (full / r) : 1.F;
-        const auto need = static_cast<std::size_t>(std::ceil(part_points * scale));
-        const float ratio = gap / clusterer.horizontal_radius_at(r);
-        if (before >= need && after >= need && ratio >= ratio_min && ratio > best_ratio) {
-          best_ratio = ratio;
-          cut = 0.5F * (last->hi + slot.lo);
-          found = true;
-        }
+      const float gap = slot.lo - last->hi;
+      const float r = 0.5F * (range_of(last->hi_i) + range_of(slot.lo_i));
+      const float scale = r > full ? (full / r) * (full / r) : 1.F;
+      const auto need = static_cast<std::size_t>(std::ceil(part_points * scale));
+      const float ratio = gap / clusterer.horizontal_radius_at(r);
+      if (before >= need && after >= need && ratio >= ratio_min && ratio > best_ratio) {
+        best_ratio = ratio;
+        cut = 0.5F * (last->hi + slot.lo);
+        found = true;
       }
     }
     before += slot.count;
@@ -150,8 +215,8 @@ std::uint32_t ClusterSplitter::split(const Cloud& cloud, const EuclideanClustere
   if (!(params_.min_length_m > 0.0) || nc == 0) return 0;
   const std::size_t n = cloud.size();
   const auto min_len = static_cast<float>(params_.min_length_m);
-  for (const std::uint32_t i : clusters.indices) {
-    if (i >= n) throw std::out_of_range("ClusterSplitter: a cluster indexes a point past the cloud's end");
+  if (!all_below(clusters.indices, n)) {
+    throw std::out_of_range("ClusterSplitter: a cluster indexes a point past the cloud's end");
   }
   std::uint32_t cuts = 0;
   for (std::size_t c = 0; c < nc; ++c) {
@@ -176,6 +241,8 @@ std::uint32_t ClusterSplitter::split(const Cloud& cloud, const EuclideanClustere
     }
     const Spread sp{origin[0], origin[1], sum[0], sum[1], square[0], sxy, square[1], {lo[0], lo[1]}, {hi[0], hi[1]}};
     if (std::hypot(sp.hi[0] - sp.lo[0], sp.hi[1] - sp.lo[1]) < min_len) continue;
+    // A point not finite leaves no axis (and no slot to put it in): the cluster stays whole.
+    if (!std::isfinite(sum[0] + sum[1] + square[0] + square[1] + sxy)) continue;
     float cut = 0.F;
     if (!find_cut(cloud, clusterer, members, sp, cut)) continue;
     if (cuts == 0) {  // the first cut: every point labelled with its cluster

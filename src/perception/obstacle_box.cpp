@@ -346,32 +346,43 @@ void refine(std::vector<P2>& kept, std::span<const P2> corners, float ox, float 
 // a dense footprint is left out: of the 9,483 points of a shed's three walls the octagon keeps 827 (16 even
 // directions kept 697 at twice the cost), refine() all but 62 of those. A point not finite, or one beyond
 // kFilterReach: drop_interior_16() instead.
-Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
+Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept, std::vector<float>& marks) {
   const std::size_t n = all.size();
   // The least and greatest x, y, x + y and x - y, four lanes at a time, values only (the points reaching them are
-  // found after: tracking indices too doubled this loop).
+  // found after: tracking indices too doubled this loop). After every block of kBlock points the eight running
+  // extremes are noted in `marks` (as below, counter-clockwise), so that the first point reaching an extreme is
+  // looked for in the one block where its running value first reached it: a scan for them from the start went
+  // through most of a wall's points.
   constexpr float kInf = std::numeric_limits<float>::infinity();
+  constexpr std::size_t kExt = 8, kBlock = 64;
   simd::f32x4 lo_x = simd::splat(kInf), lo_y = lo_x, lo_s = lo_x, lo_d = lo_x;
   simd::f32x4 hi_x = simd::splat(-kInf), hi_y = hi_x, hi_s = hi_x, hi_d = hi_x;
   simd::f32x4 wild = simd::splat(0.F);  // NaN from here on once a point is not finite (or x + y overflows)
   const std::size_t n4 = n - n % 4;
-  for (std::size_t i = 0; i < n4; i += 4) {
-    simd::f32x4 px, py;
-    load4(all, i, px, py);
-    const simd::f32x4 ps = px + py, pd = px - py;
-    wild += ps - ps;  // x + y is not finite when x or y is not
-    lo_x = simd::min_or_bound(px, lo_x);
-    hi_x = simd::max_or_bound(px, hi_x);
-    lo_y = simd::min_or_bound(py, lo_y);
-    hi_y = simd::max_or_bound(py, hi_y);
-    lo_s = simd::min_or_bound(ps, lo_s);
-    hi_s = simd::max_or_bound(ps, hi_s);
-    lo_d = simd::min_or_bound(pd, lo_d);
-    hi_d = simd::max_or_bound(pd, hi_d);
+  const std::size_t blocks = (n4 + kBlock - 1) / kBlock;
+  marks.resize(blocks * kExt * 4);
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t end = std::min(n4, (b + 1) * kBlock);
+    for (std::size_t i = b * kBlock; i < end; i += 4) {
+      simd::f32x4 px, py;
+      load4(all, i, px, py);
+      const simd::f32x4 ps = px + py, pd = px - py;
+      wild += ps - ps;  // x + y is not finite when x or y is not
+      lo_x = simd::min_or_bound(px, lo_x);
+      hi_x = simd::max_or_bound(px, hi_x);
+      lo_y = simd::min_or_bound(py, lo_y);
+      hi_y = simd::max_or_bound(py, hi_y);
+      lo_s = simd::min_or_bound(ps, lo_s);
+      hi_s = simd::max_or_bound(ps, hi_s);
+      lo_d = simd::min_or_bound(pd, lo_d);
+      hi_d = simd::max_or_bound(pd, hi_d);
+    }
+    float* const at = marks.data() + b * kExt * 4;
+    const std::array<simd::f32x4, kExt> now{hi_x, hi_s, hi_y, lo_d, lo_x, lo_s, lo_y, hi_d};
+    for (std::size_t k = 0; k < kExt; ++k) std::memcpy(at + 4 * k, &now[k], sizeof now[k]);
   }
   // Per extreme, counter-clockwise by direction: +x, +(x + y), +y, -(x - y), -x, -(x + y), -y, +(x - y); the
   // greatest of value * sign.
-  constexpr std::size_t kExt = 8;
   const std::array<simd::f32x4, kExt> lanes{hi_x, hi_s, hi_y, lo_d, lo_x, lo_s, lo_y, hi_d};
   constexpr std::array<float, kExt> sign{1.F, 1.F, 1.F, -1.F, -1.F, -1.F, -1.F, 1.F};
   const auto project = [](float x, float y, std::size_t k) {
@@ -395,32 +406,36 @@ Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept) {
     drop_interior_16(all, kept);
     return Seen{false, reach};
   }
-  // The first point reaching each extreme (deterministic), in one scan that ends when all are found.
+  // The first point reaching each extreme (deterministic): in the first block whose noted running value reached
+  // it (the value itself: sign * best[k] is exact), else among the last few. (None found cannot happen, a corner
+  // of the polygon that is no extreme would leave the test exact anyway: every corner is an input point.)
   std::array<std::size_t, kExt> ext{};
-  unsigned missing = (1U << kExt) - 1U;
-  const auto check = [&](std::size_t i) {
-    for (std::size_t k = 0; k < kExt; ++k) {
-      if ((missing & (1U << k)) != 0U && sign[k] * project(all[i][0], all[i][1], k) == best[k]) {
-        ext[k] = i;
-        missing &= ~(1U << k);
+  for (std::size_t k = 0; k < kExt; ++k) {
+    const float target = sign[k] * best[k];
+    const simd::f32x4 want = simd::splat(target);
+    bool found = false;
+    for (std::size_t b = 0; b < blocks && !found; ++b) {
+      if (simd::mask_bits(simd::load(marks.data() + (b * kExt + k) * 4) == want) == 0U) continue;
+      const std::size_t end = std::min(n4, (b + 1) * kBlock);
+      for (std::size_t i = b * kBlock; i < end; i += 4) {
+        simd::f32x4 px, py;
+        load4(all, i, px, py);
+        const std::size_t axis = k % 4;  // x, x + y, y, x - y
+        const simd::f32x4 v = axis == 0 ? px : axis == 1 ? px + py : axis == 2 ? py : px - py;
+        const unsigned hit = simd::mask_bits(v == want);
+        if (hit != 0U) {
+          ext[k] = i + static_cast<unsigned>(__builtin_ctz(hit));
+          found = true;
+          break;
+        }
       }
     }
-  };
-  {
-    const simd::f32x4 bx0 = simd::splat(max_x), bx1 = simd::splat(min_x), by0 = simd::splat(max_y),
-                      by1 = simd::splat(min_y), bs0 = simd::splat(best[1]), bs1 = simd::splat(-best[5]),
-                      bd0 = simd::splat(best[7]), bd1 = simd::splat(-best[3]);
-    std::size_t i = 0;
-    for (; i < n4 && missing != 0U; i += 4) {
-      simd::f32x4 px, py;
-      load4(all, i, px, py);
-      const simd::f32x4 ps = px + py, pd = px - py;
-      const simd::i32x4 hit =
-          (px == bx0) | (px == bx1) | (py == by0) | (py == by1) | (ps == bs0) | (ps == bs1) | (pd == bd0) | (pd == bd1);
-      if (simd::mask_bits(hit) == 0U) continue;
-      for (std::size_t j = 0; j < 4; ++j) check(i + j);
+    for (std::size_t i = n4; i < n && !found; ++i) {
+      if (project(all[i][0], all[i][1], k) == target) {
+        ext[k] = i;
+        found = true;
+      }
     }
-    for (i = std::max(i, n4); i < n && missing != 0U; ++i) check(i);
   }
   kept.clear();
   // The polygon's edges without repeated corners (a corner extreme along several directions), as lines.
@@ -520,7 +535,7 @@ Seen hull_of(std::span<const P2> all, std::vector<P2>& hull, HullScratch& hs) {
   std::vector<P2>& scratch = hs.points;
   Seen seen;
   if (all.size() > 64) {
-    seen = drop_interior(all, scratch);
+    seen = drop_interior(all, scratch, hs.marks);
   } else {
     scratch.assign(all.begin(), all.end());
   }

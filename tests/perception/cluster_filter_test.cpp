@@ -228,6 +228,71 @@ TEST(ClusterFilter, BoundsGiveTheSummaryBeforeAndAfterAMerge) {
   EXPECT_THROW(merge_bounds(two_targets, id, 1, bounds, bounds_scratch), std::invalid_argument);
 }
 
+// bound_clusters folds a cluster of 8 points or more four at a time (a run of four indices loaded straight, others
+// gathered), then the lanes: it must still give summarize's bits where the order of the points tells, between -0
+// and +0 (ties everywhere here), pass over NaN as summarize does, and take every member whatever the order of
+// the indices (runs, shuffled, descending, with gaps).
+TEST(ClusterFilter, BoundsFoldedFourAtATimeAreSummarizesBitForBit) {
+  testing::TestRng rng(11);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  Buffer<ClusterBounds> bounds;
+  for (int trial = 0; trial < 400; ++trial) {
+    // Half the trials from values with both zeros (the lanes' order would show), half without a zero (the
+    // four-lane result itself is what comes out).
+    const bool zeros = trial % 8 < 4;
+    const auto pick = [&] {
+      const float r = rng.uniform(0.F, 1.F);
+      if (r < 0.1F) return nan;
+      if (zeros) return r < 0.4F ? 0.F : r < 0.7F ? -0.F : r < 0.85F ? 1.F : -1.F;
+      return r < 0.4F ? 0.5F : r < 0.7F ? -2.F : r < 0.85F ? 3.F : -0.25F;
+    };
+    Cloud c;
+    std::vector<float> h;
+    std::vector<std::uint8_t> guessed;
+    const auto n = static_cast<std::uint32_t>(8 + rng.uniform(0.F, 60.F));
+    for (std::uint32_t i = 0; i < n; ++i) {
+      c.push_back(pick(), pick(), pick());
+      h.push_back(pick());
+      // Any nonzero byte is a guess; now and then one that is not, inside a run of four.
+      const bool guess = rng.uniform(0.F, 1.F) < (trial % 3 == 0 ? 0.99F : 0.9F);
+      guessed.push_back(guess ? static_cast<std::uint8_t>(1 + i % 3) : 0U);
+    }
+    std::vector<std::uint32_t> members;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (trial % 4 != 3 || i % 5 != 2) members.push_back(i);  // trial % 4 == 3: gaps
+    }
+    if (trial % 4 == 1) {
+      for (std::size_t i = members.size(); i > 1; --i) {
+        const auto j = std::min(i - 1, static_cast<std::size_t>(rng.uniform(0.F, static_cast<float>(i))));
+        std::swap(members[i - 1], members[j]);
+      }
+    } else if (trial % 4 == 2) {
+      std::reverse(members.begin(), members.end());
+    }
+    const Clusters k = testing::clusters_of({members, {0U}});
+    for (const bool with_guesses : {true, false}) {
+      const std::span<const std::uint8_t> g =
+          with_guesses ? std::span<const std::uint8_t>{guessed} : std::span<const std::uint8_t>{};
+      bound_clusters(c, h, g, k, bounds);
+      ASSERT_EQ(bounds.size(), 2U);
+      expect_same_summary(summary_of(bounds[0], static_cast<std::uint32_t>(members.size())),
+                          summarize(c, h, g, members), trial);
+    }
+  }
+  // An index past the end inside a long cluster throws as in a short one.
+  Cloud c;
+  for (int i = 0; i < 12; ++i) c.push_back(static_cast<float>(i), 1.F, 1.F);
+  const std::vector<float> h(12, 0.5F);
+  std::vector<std::uint32_t> past{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};
+  for (const std::size_t at : {std::size_t{2}, std::size_t{9}}) {
+    for (const std::uint32_t bad : {12U, 0x80000000U, 0xFFFFFFFFU}) {
+      std::vector<std::uint32_t> members = past;
+      members[at] = bad;
+      EXPECT_THROW(bound_clusters(c, h, {}, testing::clusters_of({members}), bounds), std::out_of_range) << bad;
+    }
+  }
+}
+
 // Standing only on guessed ground (nothing measured near), a cluster's height is at most what it shows: one
 // flat ring far out does not become a metre-high obstacle because the ground was extrapolated a metre low.
 TEST(ClusterFilter, GuessedGroundLimitsTheHeightToTheClustersOwnExtent) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -220,6 +221,46 @@ TEST(ClusterSplitter, BadParametersAndIndicesThrow) {
   EuclideanClusterer clusterer(cluster_params());
   ClusterSplitter s(split_params());
   EXPECT_THROW(s.split(c, clusterer, k), std::out_of_range);
+  // The indices are checked eight at a time: one past the end anywhere among them, however large, throws.
+  for (int i = 1; i < 20; ++i) c.push_back(static_cast<float>(i), 1.F, 1.F);
+  for (const std::size_t at : {std::size_t{0}, std::size_t{5}, std::size_t{11}, std::size_t{17}}) {
+    for (const std::uint32_t bad : {20U, 0x7FFFFFFFU, 0x80000000U, 0xFFFFFFFFU}) {
+      std::vector<std::uint32_t> members = range(0, 18);
+      members[at] = bad;
+      Clusters past = clusters_of({range(18, 20), members});
+      EXPECT_THROW(s.split(c, clusterer, past), std::out_of_range) << at << " " << bad;
+    }
+  }
+  Clusters fine = clusters_of({range(0, 20)});
+  EXPECT_EQ(s.split(c, clusterer, fine), 0U);  // valid: no throw (and 20 returns are too few for two parts)
+}
+
+// Two crowns the clusterer joined, with a point that is not finite among them: no axis to cut along, so the
+// cluster stays whole.
+TEST(ClusterSplitter, APointNotFiniteOrFarOutLeavesTheClusterWhole) {
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    Cloud c;
+    add_crown(c, {6.F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F});
+    add_crown(c, {8.4F, -3.75F, 0.6F}, {1.05F, 0.9F, 0.9F});
+    const auto all = static_cast<std::uint32_t>(c.size());
+    c.push_back(7.F, bad, 0.6F);
+    EuclideanClusterer clusterer(cluster_params());
+    ClusterSplitter s(split_params());
+    Clusters k = clusters_of({range(0, all + 1)});
+    EXPECT_EQ(s.split(c, clusterer, k), 0U);
+    EXPECT_EQ(sets_of(k), (Sets{range(0, all + 1)}));
+    Clusters whole = clusters_of({range(0, all)});  // without it, cut as ever
+    EXPECT_EQ(s.split(c, clusterer, whole), 1U);
+  }
+  // Finite, but spread over most of the float range: the projections overflow, the cluster stays whole.
+  Cloud wide;
+  for (const float x : {-3e38F, 3e38F, 0.F, 0.F, 1.F, 2.F}) wide.push_back(x, x == 0.F ? 3e38F : 1.F, 0.F);
+  wide.y[3] = -3e38F;
+  EuclideanClusterer clusterer(cluster_params());
+  ClusterSplitter s(split_params());
+  Clusters k = clusters_of({range(0, 6)});
+  EXPECT_EQ(s.split(wide, clusterer, k), 0U);
+  EXPECT_EQ(sets_of(k), (Sets{range(0, 6)}));
 }
 
 }  // namespace

@@ -432,6 +432,31 @@ TEST(ObstacleBoxReference, FacesAsThePipelineSeesThem) {
   }
 }
 
+// The pre-filter finds the first point reaching each of its eight extremes in the block of 64 where its running
+// value first reached it, or among the last few points (past a multiple of four): an extreme put at the first
+// point, either side of a block's end, in the last block or in the last few, alone or repeated in a later block.
+TEST(ObstacleBoxReference, ExtremesAnywhereInTheFootprint) {
+  TestRng rng(17);
+  constexpr std::array<float, 16> kDirs{1.F,  0.F, 1.F,  1.F,  0.F, 1.F,  -1.F, 1.F,
+                                        -1.F, 0.F, -1.F, -1.F, 0.F, -1.F, 1.F,  -1.F};
+  constexpr std::array<std::size_t, 5> kCounts{65, 67, 130, 255, 1001};
+  int trial = 0;
+  for (const std::size_t n : kCounts) {
+    for (const std::size_t at : {std::size_t{0}, std::size_t{63}, std::size_t{64}, n / 2, n - 5, n - 1}) {
+      for (std::size_t dir = 0; dir < 8; ++dir, ++trial) {
+        std::vector<P2> pts = faces(rng, n);
+        const float reach = 200.F;
+        pts[at] = {pts[at][0] + reach * kDirs[2 * dir], pts[at][1] + reach * kDirs[2 * dir + 1]};
+        expect_as_reference(pts, "extreme", trial);
+        if (at + 70 < n) {  // the same point again a block later: the first is the corner
+          pts[at + 70] = pts[at];
+          expect_as_reference(pts, "repeated extreme", trial);
+        }
+      }
+    }
+  }
+}
+
 // Points snapped to a coarse lattice: many duplicates, many collinear, equal areas and equal counts everywhere,
 // so which of equal candidates wins is tested; some points on the axes (x or y exactly -0 or +0).
 TEST(ObstacleBoxReference, LatticesDuplicatesAndSignedZeros) {

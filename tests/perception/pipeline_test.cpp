@@ -3,11 +3,19 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstddef>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <vector>
 
 #include "../../benchmarks/synthetic_scene.hpp"
+#include "fieldguard/perception/crop.hpp"
+#include "fieldguard/perception/ground.hpp"
+#include "fieldguard/perception/ransac_ground.hpp"
+#include "fieldguard/perception/voxel_grid.hpp"
+#include "fieldguard/perception/zone_ground.hpp"
 #include "perception/test_clouds.hpp"
 
 namespace fieldguard::perception {
@@ -116,6 +124,61 @@ TEST(Pipeline, ObstaclesNearestFirstAndCountsAddUp) {
     EXPECT_GE(o.height_above_ground_m, 0.5F);  // fieldguard.yaml's height filter
     EXPECT_GE(o.obb_length_m, o.obb_width_m);
   }
+}
+
+// The labelled points are the voxels, in their order and to the bit, Ground exactly where the ground stage says
+// so, and a point beyond the ROI's far end (kept as the ground stage's context only) in no cluster. (The pipeline
+// writes them four at a time; the frames' voxel counts leave every remainder of four.)
+TEST(Pipeline, LabelledPointsAreTheVoxelsWithTheGroundStagesLabels) {
+  const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+  // The field, less a few points, with a post beyond the ROI's far end (in the ground context) of as many returns.
+  std::vector<std::vector<LidarPoint>> frames;
+  for (std::size_t cut = 0; cut < 8; ++cut) {
+    frames.emplace_back(field_scan().begin(), field_scan().end() - static_cast<std::ptrdiff_t>(97 * cut));
+    for (std::size_t k = 0; k <= cut; ++k) {
+      frames.back().push_back(testing::lidar_point(56.F, 0.5F * static_cast<float>(k), 0.2F * static_cast<float>(k)));
+    }
+  }
+  std::set<std::size_t> remainders;
+  for (const auto& params : {PipelineParams{}, published_params()}) {
+    for (const auto& pts : frames) {
+      Pipeline pipe(params);
+      const FrameResult r = pipe.process(pts);
+      Box3 crop = params.roi;
+      crop.max[0] += params.ground.context_m;
+      Cloud cropped, voxels;
+      crop_box(pts, crop, params.body, cropped);
+      VoxelGrid(params.voxel).filter(cropped, voxels);
+      GroundLabels g;
+      if (params.ground.method == GroundMethod::Ransac) {
+        RansacGround(params.ground.ransac, params.ground.zones.sensor_height_m).segment(voxels, g);
+      } else {
+        ZoneGround(params.ground.zones).segment(voxels, g);
+      }
+      const auto points = pipe.last_points();
+      ASSERT_EQ(points.size(), voxels.size());
+      remainders.insert(points.size() % 4);
+      const auto far = static_cast<float>(params.roi.max[0]);
+      std::uint32_t ground = 0, beyond = 0;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        ASSERT_EQ(bits(points[i].x), bits(voxels.x[i])) << i;
+        ASSERT_EQ(bits(points[i].y), bits(voxels.y[i])) << i;
+        ASSERT_EQ(bits(points[i].z), bits(voxels.z[i])) << i;
+        const bool is_ground = g.ground[i] != 0U;
+        ASSERT_EQ(points[i].label == PointLabel::Ground, is_ground) << i;
+        ground += is_ground ? 1U : 0U;
+        if (!is_ground && voxels.x[i] > far) {
+          ++beyond;
+          EXPECT_EQ(points[i].label, PointLabel::Unclustered) << i;
+        }
+      }
+      EXPECT_EQ(ground, r.counts.ground);
+      if (params.ground.context_m > 0.0) {
+        EXPECT_GT(beyond, 0U) << "the test needs points in the ground context";
+      }
+    }
+  }
+  EXPECT_EQ(remainders.size(), 4U) << "the frames should leave every remainder of four voxels";
 }
 
 // On a flat field, a 0.6 m high box is an obstacle and a 0.3 m clod is terrain (height above local ground).

@@ -70,7 +70,7 @@ class ClusterSplitter {
   struct Slot {
     std::uint32_t count;
     float lo, hi;              // the lowest and highest projection in it
-    std::uint32_t lo_i, hi_i;  // ... and their points
+    std::uint32_t lo_i, hi_i;  // ... and the first members reaching them (looked for only when a gap may count)
   };
   Buffer<float> t_;  // per member of the cluster looked at: its projection on the long axis
   Buffer<Slot> slots_;

@@ -28,6 +28,7 @@ struct HullScratch {
   std::vector<std::array<float, 2>> points;
   std::vector<std::uint64_t> keys, keys_tmp;
   std::vector<std::uint32_t> counts;
+  std::vector<float> marks;  // the hull pre-filter's running extremes, block by block
 };
 
 // Convex hull of `pts` counter-clockwise without collinear points, from the lowest-leftmost point (Andrew's
