@@ -34,6 +34,19 @@ ClusterBounds no_bounds(bool all_guessed) {
   return ClusterBounds{{kBig, kBig, kBig}, {-kBig, -kBig, -kBig}, kBig, -kBig, kBig, all_guessed};
 }
 
+// One point into a cluster's figures (a tie keeps what the figure has).
+inline void fold_point(ClusterBounds& b, float x, float y, float z, float h) {
+  b.min[0] = std::min(b.min[0], x);
+  b.max[0] = std::max(b.max[0], x);
+  b.min[1] = std::min(b.min[1], y);
+  b.max[1] = std::max(b.max[1], y);
+  b.min[2] = std::min(b.min[2], z);
+  b.max[2] = std::max(b.max[2], z);
+  b.r2 = std::min(b.r2, x * x + y * y);
+  b.top = std::max(b.top, h);
+  b.bottom = std::min(b.bottom, h);
+}
+
 // One cluster's figures, its points folded in in order (a tie keeps what it has): what summarize reports and
 // bound_clusters keeps, so that both give the same bits. `n` is the cloud's size, for the index check.
 ClusterBounds fold_points(const Cloud& cloud, std::span<const float> height_m, std::span<const std::uint8_t> guessed,
@@ -42,16 +55,7 @@ ClusterBounds fold_points(const Cloud& cloud, std::span<const float> height_m, s
   for (const std::uint32_t i : indices) {
     if (i >= n) throw std::out_of_range(std::string(who) + ": a cluster indexes a point past the cloud's end");
     b.ground_guessed = b.ground_guessed && guessed[i] != 0U;
-    const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
-    b.min[0] = std::min(b.min[0], x);
-    b.max[0] = std::max(b.max[0], x);
-    b.min[1] = std::min(b.min[1], y);
-    b.max[1] = std::max(b.max[1], y);
-    b.min[2] = std::min(b.min[2], z);
-    b.max[2] = std::max(b.max[2], z);
-    b.r2 = std::min(b.r2, x * x + y * y);
-    b.top = std::max(b.top, height_m[i]);
-    b.bottom = std::min(b.bottom, height_m[i]);
+    fold_point(b, cloud.x[i], cloud.y[i], cloud.z[i], height_m[i]);
   }
   return b;
 }
@@ -126,16 +130,7 @@ ClusterBounds fold_wide(const Cloud& cloud, std::span<const float> height_m, std
   for (; k < m; ++k) {
     const std::uint32_t i = indices[k];
     if constexpr (kGuessed) b.ground_guessed = b.ground_guessed && guessed[i] != 0U;
-    const float x = px[i], y = py[i], z = pz[i];
-    b.min[0] = std::min(b.min[0], x);
-    b.max[0] = std::max(b.max[0], x);
-    b.min[1] = std::min(b.min[1], y);
-    b.max[1] = std::max(b.max[1], y);
-    b.min[2] = std::min(b.min[2], z);
-    b.max[2] = std::max(b.max[2], z);
-    b.r2 = std::min(b.r2, x * x + y * y);
-    b.top = std::max(b.top, ph[i]);
-    b.bottom = std::min(b.bottom, ph[i]);
+    fold_point(b, px[i], py[i], pz[i], ph[i]);
   }
   // (x^2 + y^2 is never -0.)
   const bool zero = b.min[0] == 0.F || b.max[0] == 0.F || b.min[1] == 0.F || b.max[1] == 0.F || b.min[2] == 0.F ||
