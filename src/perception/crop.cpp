@@ -79,13 +79,19 @@ inline void copy_rings(const LidarPoint* p, std::uint16_t* ring) {
 // written point by point, each at the next free place, which moves on only when the point is kept (no branch
 // per point). The last n % 4 points, and any eight (or last four) that hold a point not from the 3D LiDAR, go
 // one by one.
-template <bool check_finite, bool split>
+// With `count`, also counts the kept points with x <= near (NaN never is) into *near_count: here, where the
+// kept fours' x are already in a register, not in a second pass over the kept points.
+template <bool check_finite, bool split, bool count>
 inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBounds& keep, const BoxBounds& drop,
                                const BoxLanes& keep4, const BoxLanes& drop4, simd::f32x4 ahead, float* x, float* y,
-                               float* z, std::uint16_t* ring, std::vector<LidarPoint>* scan2d) {
+                               float* z, std::uint16_t* ring, std::vector<LidarPoint>* scan2d, float near,
+                               std::uint32_t* near_count) {
   static_assert(offsetof(LidarPoint, x) == 0 && offsetof(LidarPoint, y) == 4 && offsetof(LidarPoint, z) == 8 &&
                 offsetof(LidarPoint, intensity) == 12);
   std::size_t k = 0;
+  const simd::f32x4 near4 = simd::splat(near);
+  simd::i32x4 minus_near = simd::splat(std::int32_t{0});  // a true comparison is -1
+  std::uint32_t near_one = 0;
   // Every point is written at the next free place, which moves on only when it is kept (no branch per point).
   // Written out four times below, not looped: g++ -O2 leaves a four-step loop rolled, at twice the instructions.
   const auto put = [&](const LidarPoint& p, unsigned kept) {
@@ -106,6 +112,7 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
       }
       kept = kept && !is_2d;
     }
+    if constexpr (count) near_one += kept && p.x <= near ? 1U : 0U;
     put(p, kept ? 1U : 0U);
   };
   // Four points from p on, all from the 3D LiDAR. Forced inline: it is called twice per loop step, and a call
@@ -138,9 +145,11 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
       // None in the ROI (a run of them where the rotation sweeps past its sides): no body test, nothing to
       // write (what lies at k and after is overwritten or trimmed).
       if (simd::mask_bits(in_roi) == 0U) return;
-      const unsigned bits = simd::mask_bits(in_roi & ~drop4.contains(px, py, pz));
+      const simd::i32x4 kept = in_roi & ~drop4.contains(px, py, pz);
+      const unsigned bits = simd::mask_bits(kept);
       if (bits != 0xFU) {
         if (bits != 0U) {
+          if constexpr (count) minus_near += kept & (px <= near4);
           put(p[0], bits & 1U);
           put(p[1], (bits >> 1U) & 1U);
           put(p[2], (bits >> 2U) & 1U);
@@ -156,6 +165,7 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
     std::memcpy(z + k, &pz, sizeof pz);
     copy_rings(p, ring + k);
     k += 4;
+    if constexpr (count) minus_near += px <= near4;
   };
   // Eight at a time: one source test and one loop step for two fours.
   static_assert(static_cast<std::uint8_t>(PointSource::Lidar3d) == 0);
@@ -184,6 +194,10 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
     }
   }
   for (; i < n; ++i) one(in[i]);
+  if constexpr (count) {
+    for (int j = 0; j < 4; ++j) near_one += static_cast<std::uint32_t>(-minus_near[j]);
+    *near_count = near_one;
+  }
   return k;
 }
 
@@ -191,9 +205,9 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
 
 namespace {
 
-template <bool split>
+template <bool split, bool count>
 void crop(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
-          std::vector<LidarPoint>* scan2d) {
+          std::vector<LidarPoint>* scan2d, float near = 0.0F, std::uint32_t* near_count = nullptr) {
   const std::size_t n = in.size();
   out.x.resize(n);
   out.y.resize(n);
@@ -209,10 +223,12 @@ void crop(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Clo
   const simd::f32x4 ahead = simd::splat(front);
   // A finite ROI already rejects NaN and infinity; only an unbounded one needs the explicit test.
   const std::size_t k = is_finite(roi)
-                            ? crop_points<false, split>(in.data(), n, keep, drop, keep4, drop4, ahead, out.x.data(),
-                                                        out.y.data(), out.z.data(), out.ring.data(), scan2d)
-                            : crop_points<true, split>(in.data(), n, keep, drop, keep4, drop4, ahead, out.x.data(),
-                                                       out.y.data(), out.z.data(), out.ring.data(), scan2d);
+                            ? crop_points<false, split, count>(in.data(), n, keep, drop, keep4, drop4, ahead,
+                                                               out.x.data(), out.y.data(), out.z.data(),
+                                                               out.ring.data(), scan2d, near, near_count)
+                            : crop_points<true, split, count>(in.data(), n, keep, drop, keep4, drop4, ahead,
+                                                              out.x.data(), out.y.data(), out.z.data(),
+                                                              out.ring.data(), scan2d, near, near_count);
   out.x.resize(k);
   out.y.resize(k);
   out.z.resize(k);
@@ -222,13 +238,21 @@ void crop(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Clo
 }  // namespace
 
 void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out) {
-  crop<false>(in, roi, body, out, nullptr);
+  crop<false, false>(in, roi, body, out, nullptr);
 }
 
 void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
               std::vector<LidarPoint>& scan2d) {
   scan2d.clear();
-  crop<true>(in, roi, body, out, &scan2d);
+  crop<true, false>(in, roi, body, out, &scan2d);
+}
+
+std::uint32_t crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
+                       std::vector<LidarPoint>& scan2d, float count_x_max) {
+  scan2d.clear();
+  std::uint32_t near = 0;
+  crop<true, true>(in, roi, body, out, &scan2d, count_x_max, &near);
+  return near;
 }
 
 }  // namespace fieldguard::perception

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -164,6 +165,63 @@ TEST(CropBox, FourAtATimeMatchesThePointByPointTest) {
       }
       crop_box(in, roi, kBody, out);
       EXPECT_EQ(std::vector<std::uint16_t>(out.ring.begin(), out.ring.end()), want_all) << n << " points";
+    }
+  }
+}
+
+// The counting overload: the same crop, and the count a second pass `x <= limit` over the kept points gives, on
+// every path (fours kept whole, fast and full test, fours kept in part, eights holding a 2D point, the last
+// points), for a limit on a point's x, between points, NaN and infinite.
+TEST(CropBox, CountsTheKeptPointsUpToALimit) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const double dinf = std::numeric_limits<double>::infinity();
+  const Box3 half_open{{-10.0, -dinf, -1.5}, {50.0, 10.0, dinf}};
+  std::mt19937 rng(11);
+  const auto second_pass = [](const Cloud& c, float limit) {
+    std::uint32_t n = 0;
+    for (const float x : c.x) n += x <= limit ? 1U : 0U;
+    return n;
+  };
+  for (const Box3& roi : {kRoi, half_open}) {
+    for (std::size_t n : {0U, 1U, 4U, 7U, 8U, 13U, 1003U}) {
+      std::vector<LidarPoint> in;
+      for (std::size_t i = 0; i < n; ++i) {
+        // x on a 0.25 m grid from -12 m to 55 m (runs inside the ROI ahead of the body, in it, beyond it), y
+        // mostly inside, now and then beside the ROI or NaN.
+        const float x = -12.F + 0.25F * static_cast<float>(rng() % 269);
+        float y = static_cast<float>(rng() % 9) - 4.F;
+        if (rng() % 17 == 0) y = 11.F;
+        if (rng() % 23 == 0) y = nan;
+        in.push_back(lidar_point(x, y, 0.5F, static_cast<std::uint16_t>(i)));
+        if (rng() % 29 == 0) in.back().source = static_cast<std::uint8_t>(PointSource::Lidar2d);
+        if (rng() % 31 == 0) in.back().x = nan;
+      }
+      // Sorted runs as well: whole fours kept (the vector count), whole fours beyond the limit.
+      if (n > 100) std::sort(in.begin(), in.begin() + 400, [](const LidarPoint& a, const LidarPoint& b) {
+          return a.x < b.x;
+        });
+      Cloud expected;
+      std::vector<LidarPoint> expected2d;
+      crop_box(in, roi, kBody, expected, expected2d);
+      for (const float limit : {20.F, 20.1F, 50.F, 0.4F, -10.F, -20.F, nan, std::numeric_limits<float>::infinity()}) {
+        Cloud out;
+        std::vector<LidarPoint> scan;
+        const std::uint32_t counted = crop_box(in, roi, kBody, out, scan, limit);
+        EXPECT_EQ(counted, second_pass(out, limit)) << n << " points, limit " << limit;
+        ASSERT_EQ(out.size(), expected.size());
+        for (std::size_t k = 0; k < out.size(); ++k) {
+          EXPECT_EQ(out.ring[k], expected.ring[k]);
+          EXPECT_EQ(out.x[k], expected.x[k]);
+        }
+        EXPECT_EQ(scan.size(), expected2d.size());
+      }
+      if (n == 1003U) {
+        // The test has teeth: some kept points lie beyond 20 m and some at or before it.
+        const std::uint32_t at_20 = second_pass(expected, 20.F);
+        EXPECT_GT(at_20, 0U);
+        EXPECT_LT(at_20, expected.size());
+        EXPECT_LT(second_pass(expected, 19.9F), at_20);  // points exactly at 20 m are kept and counted
+      }
     }
   }
 }

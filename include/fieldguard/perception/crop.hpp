@@ -2,6 +2,7 @@
 // Region of interest and removal of the tractor's own body: the first stage, the cheapest, and the one
 // that shrinks the data most.
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -20,5 +21,10 @@ void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body,
 // `scan2d` instead (cleared first), all of them, in input order: in one pass, not a copy of the frame.
 void crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
               std::vector<LidarPoint>& scan2d);
+
+// The same, returning how many of the kept points have x <= count_x_max (the points of `out` a second pass
+// `x <= count_x_max` would count; a NaN count_x_max counts none).
+[[nodiscard]] std::uint32_t crop_box(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Cloud& out,
+                                     std::vector<LidarPoint>& scan2d, float count_x_max);
 
 }  // namespace fieldguard::perception
