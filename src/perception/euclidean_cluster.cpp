@@ -324,14 +324,15 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   using simd::f32x4;
   const f32x4 vinv = simd::splat(inv), lx = simd::splat(lo[0]), ly = simd::splat(lo[1]), lz = simd::splat(lo[2]);
   const auto top_x = static_cast<std::uint32_t>(nx - 1), top_y = static_cast<std::uint32_t>(ny - 1);
-  const u32x4 vtop_x = {top_x, top_x, top_x, top_x}, vtop_y = {top_y, top_y, top_y, top_y};
-  const u32x4 vtop_z = {nz_top, nz_top, nz_top, nz_top};
+  const auto vtop_x = simd::splat(static_cast<std::int32_t>(top_x));
+  const auto vtop_y = simd::splat(static_cast<std::int32_t>(top_y));
+  const auto vtop_z = simd::splat(static_cast<std::int32_t>(nz_top));
   // Four points at a time: lane by lane the operations of the scalar `cell`, so the same cells to the bit. Every
-  // value is finite here, and a cell index is below max_cols, far from the top bit: the conversions and the
-  // unsigned minimum see nothing out of range.
-  const auto cells = [&](f32x4 v, f32x4 origin, u32x4 top) {
-    const auto c = __builtin_convertvector(__builtin_convertvector((v - origin) * vinv, simd::i32x4), u32x4);
-    return c < top ? c : top;
+  // value is finite here, and a cell index is below max_cols, far from the top bit: the conversions see nothing
+  // out of range, and the signed minimum (SSE2 has a signed compare, not an unsigned one) is the unsigned one.
+  const auto cells = [&](f32x4 v, f32x4 origin, simd::i32x4 top) {
+    const auto c = __builtin_convertvector((v - origin) * vinv, simd::i32x4);
+    return __builtin_convertvector(c < top ? c : top, u32x4);
   };
   std::size_t i4 = 0;
   {
