@@ -92,14 +92,18 @@ ZoneGround::Fit ZoneGround::least_squares(const GroundPlane& sel, float lo, floa
 
 // The diagonal of the x-y box of the points `f` was fitted to (the same selection again). Apart from
 // least_squares: of a bin's several fits only the last one's is looked at, and only for a bin that passed the
-// slope tests.
-float ZoneGround::spread(const Fit& f) const {
+// slope tests. In the same pass, whether any point of pts_ lies more than `deepest` below f.plane (into `below`;
+// -inf: none ever does), the last test fit_bin makes, on the points already loaded.
+float ZoneGround::spread(const Fit& f, float deepest, bool& below) const {
   using simd::f32x4;
   using simd::i32x4;
   const f32x4 sa = simd::splat(f.sel.a), sb = simd::splat(f.sel.b), sc = simd::splat(f.sel.c);
   const f32x4 vlo = simd::splat(f.lo), vhi = simd::splat(f.hi);
+  const f32x4 pa = simd::splat(f.plane.a), pb = simd::splat(f.plane.b), pc = simd::splat(f.plane.c);
+  const f32x4 vdeep = simd::splat(deepest);
   const f32x4 big = simd::splat(std::numeric_limits<float>::max());
   f32x4 x0 = big, x1 = -big, y0 = big, y1 = -big;
+  i32x4 deep = simd::splat(0);
   for (std::size_t i = 0; i < pts_.padded; i += 4) {
     const f32x4 x = simd::load(pts_.x + i), y = simd::load(pts_.y + i), z = simd::load(pts_.z + i);
     const f32x4 r = z - (sa * x + sb * y + sc);
@@ -108,7 +112,9 @@ float ZoneGround::spread(const Fit& f) const {
     x1 = in ? (x > x1 ? x : x1) : x1;
     y0 = in ? (y < y0 ? y : y0) : y0;
     y1 = in ? (y > y1 ? y : y1) : y1;
+    deep |= z - (pa * x + pb * y + pc) < vdeep;
   }
+  below = simd::mask_bits(deep) != 0U;
   const float ex = std::max({x1[0], x1[1], x1[2], x1[3]}) - std::min({x0[0], x0[1], x0[2], x0[3]});
   const float ey = std::max({y1[0], y1[1], y1[2], y1[3]}) - std::min({y0[0], y0[1], y0[2], y0[3]});
   return std::sqrt(ex * ex + ey * ey);
@@ -259,7 +265,11 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   const float max_change = tan_max_change_;
   const float da = f.plane.a - prior.plane.a, db = f.plane.b - prior.plane.b;
   if (da * da + db * db > max_change * max_change) return;
-  if (spread(f) < static_cast<float>(params_.min_spread_m)) return;
+  // The lower-envelope test below, on the points spread() loads anyway.
+  const float deepest =
+      params_.max_below_m > 0.0 ? -static_cast<float>(params_.max_below_m) : -std::numeric_limits<float>::infinity();
+  bool below = false;
+  if (spread(f, deepest, below) < static_cast<float>(params_.min_spread_m)) return;
   const float step = f.plane.z_at(f.mean_x, f.mean_y) - prior.plane.z_at(f.mean_x, f.mean_y);
   const float ddx = f.mean_x - prior.ref_x, ddy = f.mean_y - prior.ref_y;
   const float dist = std::sqrt(ddx * ddx + ddy * ddy);
@@ -270,15 +280,7 @@ void ZoneGround::fit_bin(std::uint32_t bin, const Bin& prior) {
   // row's crowns, and their returns make a flat, wide "ground" a metre up, with a lower laser's return under it.
   // Four at a time over the padding too: a padding point is its run's first point a million metres up, so its
   // residual is never below that point's (rounding is monotonic), and the answer is the same.
-  if (params_.max_below_m > 0.0) {
-    using simd::f32x4;
-    const f32x4 deepest = simd::splat(-static_cast<float>(params_.max_below_m));
-    const f32x4 pa = simd::splat(f.plane.a), pb = simd::splat(f.plane.b), pc = simd::splat(f.plane.c);
-    for (std::size_t i = 0; i < pts_.padded; i += 4) {
-      const f32x4 r = simd::load(pts_.z + i) - (pa * simd::load(pts_.x + i) + pb * simd::load(pts_.y + i) + pc);
-      if (simd::mask_bits(r < deepest) != 0U) return;
-    }
-  }
+  if (below) return;
   out.plane = f.plane;
   out.ref_x = f.mean_x;
   out.ref_y = f.mean_y;

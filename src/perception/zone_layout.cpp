@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <vector>
@@ -145,36 +146,50 @@ void ZoneGround::bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const {
   }
   std::vector<f32x4> ends;  // ends[k]: where zone k + 1 begins
   for (std::size_t k = 1; k < zones_.size(); ++k) ends.push_back(simd::splat(zones_[k - 1].r1));
+  // Up to kFixedEnds ends (five zones) also in a fixed array, the rest NaN, which no range passes (every comparison
+  // with NaN is false): a loop of known length, unrolled, its ends kept in registers.
+  constexpr std::size_t kFixedEnds = 4;
+  std::array<f32x4, kFixedEnds> fixed_ends{};
+  fixed_ends.fill(simd::splat(std::numeric_limits<float>::quiet_NaN()));
+  std::copy(ends.begin(), ends.begin() + static_cast<std::ptrdiff_t>(std::min(ends.size(), kFixedEnds)),
+            fixed_ends.begin());
   const Rows* const row = rows.data();
   const f32x4 zero = simd::splat(0.F), pi = simd::splat(std::numbers::pi_v<float>);
   std::size_t p = 0;
-  for (; p + 4 <= n; p += 4) {
-    const f32x4 x = simd::load(in.x.data() + p), y = simd::load(in.y.data() + p);
-    const f32x4 r2 = x * x + y * y;
+  const auto run = [&](const auto& zone_ends) {
+    for (; p + 4 <= n; p += 4) {
+      const f32x4 x = simd::load(in.x.data() + p), y = simd::load(in.y.data() + p);
+      const f32x4 r2 = x * x + y * y;
 #if defined(__SSE2__)
-    const f32x4 r = _mm_sqrt_ps(r2);  // correctly rounded, as std::sqrt
+      const f32x4 r = _mm_sqrt_ps(r2);  // correctly rounded, as std::sqrt
 #else
-    const f32x4 r = {std::sqrt(r2[0]), std::sqrt(r2[1]), std::sqrt(r2[2]), std::sqrt(r2[3])};
+      const f32x4 r = {std::sqrt(r2[0]), std::sqrt(r2[1]), std::sqrt(r2[2]), std::sqrt(r2[3])};
 #endif
-    const f32x4 theta = fast_atan2(y, x);
-    i32x4 passed = simd::splat(0);
-    for (const f32x4& end : ends) passed -= r >= end;
-    const Rows &z0 = row[passed[0]], &z1 = row[passed[1]], &z2 = row[passed[2]], &z3 = row[passed[3]];
-    f32x4 r0 = z0.lo, inv_ring_width = z1.lo, max_ring = z2.lo, sector_scale = z3.lo;
-    simd::transpose4(r0, inv_ring_width, max_ring, sector_scale);
-    f32x4 max_sector = z0.hi, first_bits = z1.hi, sectors_bits = z2.hi, unused = z3.hi;
-    simd::transpose4(max_sector, first_bits, sectors_bits, unused);
-    i32x4 first_bin, sectors;
-    std::memcpy(&first_bin, &first_bits, sizeof first_bin);
-    std::memcpy(&sectors, &sectors_bits, sizeof sectors);
-    f32x4 rf = (r - r0) * inv_ring_width;
-    rf = rf > zero ? rf : zero;
-    rf = rf < max_ring ? rf : max_ring;
-    f32x4 sf = (theta + pi) * sector_scale;
-    sf = sf > zero ? sf : zero;
-    sf = sf < max_sector ? sf : max_sector;
-    const i32x4 b = first_bin + __builtin_convertvector(rf, i32x4) * sectors + __builtin_convertvector(sf, i32x4);
-    std::memcpy(out.data() + p, &b, sizeof b);
+      const f32x4 theta = fast_atan2(y, x);
+      i32x4 passed = simd::splat(0);
+      for (const f32x4& end : zone_ends) passed -= r >= end;
+      const Rows &z0 = row[passed[0]], &z1 = row[passed[1]], &z2 = row[passed[2]], &z3 = row[passed[3]];
+      f32x4 r0 = z0.lo, inv_ring_width = z1.lo, max_ring = z2.lo, sector_scale = z3.lo;
+      simd::transpose4(r0, inv_ring_width, max_ring, sector_scale);
+      f32x4 max_sector = z0.hi, first_bits = z1.hi, sectors_bits = z2.hi, unused = z3.hi;
+      simd::transpose4(max_sector, first_bits, sectors_bits, unused);
+      i32x4 first_bin, sectors;
+      std::memcpy(&first_bin, &first_bits, sizeof first_bin);
+      std::memcpy(&sectors, &sectors_bits, sizeof sectors);
+      f32x4 rf = (r - r0) * inv_ring_width;
+      rf = rf > zero ? rf : zero;
+      rf = rf < max_ring ? rf : max_ring;
+      f32x4 sf = (theta + pi) * sector_scale;
+      sf = sf > zero ? sf : zero;
+      sf = sf < max_sector ? sf : max_sector;
+      const i32x4 b = first_bin + __builtin_convertvector(rf, i32x4) * sectors + __builtin_convertvector(sf, i32x4);
+      std::memcpy(out.data() + p, &b, sizeof b);
+    }
+  };
+  if (ends.size() <= kFixedEnds) {
+    run(fixed_ends);
+  } else {
+    run(ends);
   }
   for (; p < n; ++p) out[p] = bin_of(in.x[p], in.y[p]);
 }

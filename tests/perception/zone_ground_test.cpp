@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -15,6 +16,7 @@
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
+#include "perception/fast_math.hpp"
 #include "perception/hypot.hpp"
 #include "perception/nth_element.hpp"
 #include "perception/test_clouds.hpp"
@@ -389,6 +391,75 @@ TEST(ZoneGround, BinsRunsOfFourInOneZoneAsOneAtATime) {
   ASSERT_EQ(bins.size(), c.size());
   for (std::size_t i = 0; i < c.size(); ++i) {
     ASSERT_EQ(bins[i], zones.bin_of(c.x[i], c.y[i])) << "point " << i << " at " << c.x[i] << ", " << c.y[i];
+  }
+}
+
+// bins_of counts passed zone ends over a fixed array of four (unused ends NaN, passed by no range) when there are at
+// most five zones, over all the ends otherwise: one zone (no end at all), five (four ends, none NaN) and seven zones
+// (the general loop) must each give bin_of's bins, on and beside every edge, for infinite and NaN points too.
+TEST(ZoneGround, BinsFourAtATimeAsOneAtATimeForAnyZoneCount) {
+  for (const std::size_t zone_count : {std::size_t{1}, std::size_t{5}, std::size_t{7}}) {
+    ZoneParams p;
+    p.edges_m = {1.0};
+    p.rings.clear();
+    p.sectors.clear();
+    for (std::size_t z = 0; z < zone_count; ++z) {
+      p.edges_m.push_back(p.edges_m.back() + 3.0 + static_cast<double>(z));
+      p.rings.push_back(1 + static_cast<int>(z % 3));
+      p.sectors.push_back(8 + 4 * static_cast<int>(z));
+    }
+    const ZoneGround zones(p);
+    Cloud c;
+    testing::TestRng rng(11);
+    const auto at = [&c](float r, float a) { c.push_back(r * std::cos(a), r * std::sin(a), 0.F); };
+    for (const double e : p.edges_m) {
+      for (const float off : {-0.2F, -1e-6F, 0.F, 1e-6F, 0.2F}) {
+        for (int k = 0; k < 4; ++k) at(static_cast<float>(e) + off, rng.uniform(-3.2F, 3.2F));
+      }
+    }
+    for (int i = 0; i < 4000; ++i) at(rng.uniform(0.F, 50.F), rng.uniform(-3.2F, 3.2F));
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    c.push_back(inf, 0.F, 0.F);
+    c.push_back(-inf, inf, 0.F);
+    c.push_back(nan, 2.F, 0.F);
+    c.push_back(-0.F, 3.F, 0.F);
+    Buffer<std::uint32_t> bins;
+    zones.bins_of(c, bins);
+    ASSERT_EQ(bins.size(), c.size());
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      ASSERT_EQ(bins[i], zones.bin_of(c.x[i], c.y[i]))
+          << zone_count << " zones, point " << i << " at " << c.x[i] << ", " << c.y[i];
+      ASSERT_LT(bins[i], zones.bin_count());
+    }
+  }
+}
+
+// fast_atan2 four at a time takes absolute values by clearing the sign bit and picks the larger and smaller with
+// maxps/minps: the scalar's bits, signed zeros, infinities and NaN included.
+TEST(ZoneGround, FastAtan2FourAtATimeAsOneAtATime) {
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> v = {0.F, -0.F, 1.F, -1.F, 3.F, -3.F, 1e-30F, -1e-30F, 1e30F, -1e30F, inf, -inf, nan, -nan};
+  testing::TestRng rng(3);
+  for (int i = 0; i < 200; ++i) v.push_back(rng.uniform(-60.F, 60.F));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    for (std::size_t j = 0; j + 3 < v.size(); j += 4) {
+      const simd::f32x4 y = simd::splat(v[i]), x = {v[j], v[j + 1], v[j + 2], v[j + 3]};
+      const simd::f32x4 r = fast_atan2(y, x), q = fast_atan2(x, y);
+      for (int l = 0; l < 4; ++l) {
+        const float want = fast_atan2(v[i], x[l]), want_swapped = fast_atan2(x[l], v[i]);
+        if (std::isnan(want)) {
+          EXPECT_TRUE(std::isnan(r[l])) << v[i] << ", " << x[l];
+        } else {
+          EXPECT_EQ(std::bit_cast<std::uint32_t>(r[l]), std::bit_cast<std::uint32_t>(want)) << v[i] << ", " << x[l];
+        }
+        if (std::isnan(want_swapped)) {
+          EXPECT_TRUE(std::isnan(q[l])) << x[l] << ", " << v[i];
+        } else {
+          EXPECT_EQ(std::bit_cast<std::uint32_t>(q[l]), std::bit_cast<std::uint32_t>(want_swapped))
+              << x[l] << ", " << v[i];
+        }
+      }
+    }
   }
 }
 

@@ -86,7 +86,7 @@ class ZoneGround {
   void fit_bin(std::uint32_t bin, const Bin& prior);
   [[nodiscard]] Fit least_squares(const GroundPlane& sel, float lo, float hi, const GroundPlane& prior,
                                   double prior_per_point) const;
-  [[nodiscard]] float spread(const Fit& f) const;
+  [[nodiscard]] float spread(const Fit& f, float deepest, bool& below) const;
   void residuals(const GroundPlane& plane, float* out) const;
   void sort_into_bins(const Cloud& in);
   void gather_innermost(std::uint32_t b0, std::uint32_t b1);
