@@ -139,14 +139,10 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   const float roi_far = static_cast<float>(m.params.roi.max[0]);
   Box3 crop = m.params.roi;
   crop.max[0] += m.params.ground.context_m;
-  // The crop counts the points within the ROI's far end as it keeps them (not a second pass over them).
-  const std::uint32_t in_roi = crop_box(points, crop, m.params.body, m.cropped, m.points2d, roi_far);
+  // The crop counts the points within the ROI's far end as it keeps them (not a second pass over them). Without
+  // a context band (context_m <= 0) that is every point it keeps: its x limit is then at most roi_far.
+  result.counts.after_roi = crop_box(points, crop, m.params.body, m.cropped, m.points2d, roi_far);
   result.counts.input = static_cast<std::uint32_t>(points.size() - m.points2d.size());
-  if (m.params.ground.context_m > 0.0) {
-    result.counts.after_roi = in_roi;
-  } else {
-    result.counts.after_roi = static_cast<std::uint32_t>(m.cropped.size());
-  }
   m.voxel.filter(m.cropped, m.voxels);
   const std::size_t n = m.voxels.size();
   result.counts.after_voxel = static_cast<std::uint32_t>(n);
