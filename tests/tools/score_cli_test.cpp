@@ -24,13 +24,13 @@ using tools_test::write_file;
 //  6 (100.6) nothing detected at all       -> no detection frame: unmatched
 //  7 (100.7) detection frame is partial    -> skipped
 constexpr const char* kTruth =
-    R"({"frame": 0, "stamp": 100.000000, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 40, "distance_m": 12.0}], "terrain": []}
-{"frame": 1, "stamp": 100.100000, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [27.0, -0.3, -0.95], "max": [27.5, 0.3, 0.8], "hits": 6, "distance_m": 27.0}], "terrain": [{"id": "c1", "class": "clod", "min": [6.9, 0.9, -0.95], "max": [7.3, 1.2, -0.6], "hits": 9}]}
-{"frame": 2, "stamp": 100.200000, "period_s": 0.1, "objects": [{"id": "i", "class": "implement", "min": [20.0, -2.0, -0.95], "max": [23.0, 0.5, 0.55], "hits": 200, "distance_m": 20.0}]}
+    R"({"frame": 0, "stamp": 100.000000, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 40, "raised_hits": 40, "distance_m": 12.0}], "terrain": []}
+{"frame": 1, "stamp": 100.100000, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [27.0, -0.3, -0.95], "max": [27.5, 0.3, 0.8], "hits": 6, "raised_hits": 6, "distance_m": 27.0}], "terrain": [{"id": "c1", "class": "clod", "min": [6.9, 0.9, -0.95], "max": [7.3, 1.2, -0.6], "hits": 9, "raised_hits": 9}]}
+{"frame": 2, "stamp": 100.200000, "period_s": 0.1, "objects": [{"id": "i", "class": "implement", "min": [20.0, -2.0, -0.95], "max": [23.0, 0.5, 0.55], "hits": 200, "raised_hits": 200, "distance_m": 20.0}]}
 
-{"frame": 3, "stamp": 100.300000, "period_s": 0.1, "objects": [{"id": "h1", "class": "haystack", "min": [15.0, 3.0, -0.95], "max": [16.5, 4.2, 0.55], "hits": 90, "distance_m": 15.3}, {"id": "h2", "class": "haystack", "min": [15.0, 4.6, -0.95], "max": [16.5, 5.8, 0.55], "hits": 80, "distance_m": 15.7}]}
-{"frame": 4, "stamp": 100.400000, "period_s": 0.1, "objects": [{"id": "A", "class": "crown", "min": [10.0, -3.0, 0.0], "max": [12.0, -1.0, 2.0], "hits": 50}, {"id": "B", "class": "crown", "min": [12.4, -3.0, 0.0], "max": [14.4, -1.0, 2.0], "hits": 40}, {"id": "C", "class": "crown", "min": [20.0, -3.0, 0.0], "max": [22.0, -1.0, 2.0], "hits": 30}, {"id": "D", "class": "crown", "min": [30.0, 2.0, 0.0], "max": [32.0, 4.0, 2.0], "hits": 20}, {"id": "E", "class": "crown", "min": [40.0, 2.0, 0.0], "max": [42.0, 4.0, 2.0], "hits": 2}]}
-{"frame": 5, "stamp": 100.500000, "period_s": 0.1, "objects": [{"id": "F", "class": "crown", "min": [10.0, -3.0, 0.0], "max": [12.0, -1.0, 2.0], "hits": 50}, {"id": "G", "class": "crown", "min": [12.4, -3.0, 0.0], "max": [14.4, -1.0, 2.0], "hits": 40}]}
+{"frame": 3, "stamp": 100.300000, "period_s": 0.1, "objects": [{"id": "h1", "class": "haystack", "min": [15.0, 3.0, -0.95], "max": [16.5, 4.2, 0.55], "hits": 90, "raised_hits": 90, "distance_m": 15.3}, {"id": "h2", "class": "haystack", "min": [15.0, 4.6, -0.95], "max": [16.5, 5.8, 0.55], "hits": 80, "raised_hits": 80, "distance_m": 15.7}]}
+{"frame": 4, "stamp": 100.400000, "period_s": 0.1, "objects": [{"id": "A", "class": "crown", "min": [10.0, -3.0, 0.0], "max": [12.0, -1.0, 2.0], "hits": 50, "raised_hits": 50}, {"id": "B", "class": "crown", "min": [12.4, -3.0, 0.0], "max": [14.4, -1.0, 2.0], "hits": 40, "raised_hits": 40}, {"id": "C", "class": "crown", "min": [20.0, -3.0, 0.0], "max": [22.0, -1.0, 2.0], "hits": 30, "raised_hits": 30}, {"id": "D", "class": "crown", "min": [30.0, 2.0, 0.0], "max": [32.0, 4.0, 2.0], "hits": 20, "raised_hits": 20}, {"id": "E", "class": "crown", "min": [40.0, 2.0, 0.0], "max": [42.0, 4.0, 2.0], "hits": 2, "raised_hits": 2}]}
+{"frame": 5, "stamp": 100.500000, "period_s": 0.1, "objects": [{"id": "F", "class": "crown", "min": [10.0, -3.0, 0.0], "max": [12.0, -1.0, 2.0], "hits": 50, "raised_hits": 50}, {"id": "G", "class": "crown", "min": [12.4, -3.0, 0.0], "max": [14.4, -1.0, 2.0], "hits": 40, "raised_hits": 40}]}
 {"frame": 6, "stamp": 100.600000, "period_s": 0.1, "objects": []}
 {"frame": 7, "stamp": 100.700000, "period_s": 0.1, "objects": []}
 )";
@@ -148,6 +148,63 @@ TEST_F(ScoreCli, CrownTruePositivesFalseAndMissed) {
   // match B (A merged, B split); the overlap rule does not let a 5 cm sliver count.
   const JsonValue loose = score_json(" --min-overlap 0");
   EXPECT_EQ(num(loose, {"crowns", "tp"}), 0);
+}
+
+// A crown seen by one ray through its foliage and two at its trunk's foot (9 returns, 1 raised) is not
+// visible: nothing that shows that little of itself above terrain height can be told from a clod or a stray
+// return. The old rule (--min-raised-hits 0) counts it, and its miss.
+TEST_F(ScoreCli, ReturnsBelowTerrainHeightDoNotMakeAnObjectVisible) {
+  write_file(dir_.file("raised.truth.jsonl"),
+             R"({"frame": 0, "stamp": 200.0, "period_s": 0.1, "objects": [)"
+             R"({"id": "T", "class": "crown", "min": [20.0, 2.0, -1.0], "max": [22.0, 4.0, 2.0], "hits": 9, "raised_hits": 1},)"
+             R"( {"id": "U", "class": "crown", "min": [20.0, -4.0, -1.0], "max": [22.0, -2.0, 2.0], "hits": 12, "raised_hits": 12},)"
+             R"( {"id": "P", "class": "pedestrian", "min": [30.0, -0.3, -1.0], "max": [30.5, 0.3, 0.8], "hits": 4, "raised_hits": 2, "distance_m": 30.0}]})"
+             "\n");
+  write_file(dir_.file("raised.det.jsonl"),
+             R"({"frame": 0, "stamp": 200.0, "obstacles": [{"min": [20.2, -3.8, 0.5], "max": [21.8, -2.2, 1.9]}]})"
+             "\n");
+  const auto score = [&](const std::string& extra) {
+    const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file("raised.det.jsonl") + " --truth " +
+                                             dir_.file("raised.truth.jsonl") + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.errors;
+    return parse_json(r.output).value.value_or(JsonValue{});
+  };
+  const JsonValue v = score("");
+  EXPECT_EQ(num(v, {"params", "min_raised_hits"}), 3);
+  EXPECT_EQ(num(v, {"crowns", "visible"}), 1);
+  EXPECT_EQ(num(v, {"crowns", "tp"}), 1);
+  EXPECT_EQ(num(v, {"crowns", "missed"}), 0);
+  EXPECT_EQ(num(v, {"classes", "pedestrian", "visible"}), -1);  // no visible pedestrian: no entry
+  const JsonValue old = score(" --min-raised-hits 0");
+  EXPECT_EQ(num(old, {"crowns", "visible"}), 2);
+  EXPECT_EQ(num(old, {"crowns", "missed"}), 1);
+  EXPECT_EQ(num(old, {"classes", "pedestrian", "visible"}), 1);
+  EXPECT_EQ(num(old, {"classes", "pedestrian", "detected"}), 0);
+  // Two raised returns are enough when asked for two: the pedestrian counts, and is missed.
+  EXPECT_EQ(num(score(" --min-raised-hits 2"), {"classes", "pedestrian", "visible"}), 1);
+}
+
+TEST_F(ScoreCli, TruthWithoutRaisedHitsIsRefusedUnlessTheOldRuleIsAsked) {
+  write_file(dir_.file("old.truth.jsonl"),
+             R"({"frame": 0, "stamp": 100.0, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 40}]})"
+             "\n");
+  auto r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("old.truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("old.truth.jsonl:1: p has no \"raised_hits\""), std::string::npos) << r.errors;
+  EXPECT_NE(r.errors.find("--min-raised-hits 0"), std::string::npos) << r.errors;
+  r = run(FIELDGUARD_SCORE, "--json --min-raised-hits 0 --detections " + dir_.file("det.jsonl") + " --truth " +
+                                dir_.file("old.truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 0) << r.errors;
+  EXPECT_EQ(num(parse_json(r.output).value.value_or(JsonValue{}), {"classes", "pedestrian", "detected"}), 1);
+
+  write_file(dir_.file("more.truth.jsonl"),
+             R"({"frame": 0, "stamp": 100.0, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 4, "raised_hits": 5}]})"
+             "\n");
+  r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("more.truth.jsonl"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.errors.find("more.truth.jsonl:1: objects[0]: \"raised_hits\" must be from 0 to \"hits\""),
+            std::string::npos) << r.errors;
+  EXPECT_EQ(run(FIELDGUARD_SCORE, "--detections a --truth b --min-raised-hits -1").exit_code, 2);
 }
 
 TEST_F(ScoreCli, PartialFramesCanBeIncluded) {

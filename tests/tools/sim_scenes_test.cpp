@@ -120,6 +120,39 @@ TEST(SimScenes, PedestrianReturnsFallWithDistance) {
   EXPECT_LE(far[far.size() / 2], 15U);
 }
 
+// raised_hits counts a return only where it stands 0.5 m or more above the surface under it: never on a clod
+// (at most 40 cm tall), on a pedestrian's body but not its feet, and never more than the hits.
+TEST(SimScenes, RaisedHitsAreTheReturnsHalfAMetreAboveTheSurface) {
+  SceneSetup setup;
+  setup.rotations = 12;
+  setup.period_s = Simulator::period_for(10.0);
+  Simulator sim(*build_scene("rough-pedestrian", setup), SimSettings{});
+  std::vector<TimedPacket> packets;
+  std::size_t clods = 0, pedestrians = 0, feet_seen = 0;
+  for (int k = 0; k < setup.rotations; ++k) {
+    packets.clear();
+    const FrameTruth t = sim.rotation(static_cast<std::uint64_t>(k), packets);
+    for (const auto* list : {&t.objects, &t.terrain}) {
+      for (const ObjectTruth& o : *list) {
+        EXPECT_LE(o.raised_hits, o.hits) << o.id;
+        if (o.cls == ObjectClass::Clod && o.hits > 0) {
+          ++clods;
+          EXPECT_EQ(o.raised_hits, 0U) << o.id << " in rotation " << k;
+        }
+        if (o.cls == ObjectClass::Pedestrian) {
+          ++pedestrians;
+          // 5 m away the body from knee to head is in the beams: most of its returns are raised.
+          EXPECT_GE(o.raised_hits * 2, o.hits) << "rotation " << k;
+          if (o.raised_hits < o.hits) ++feet_seen;
+        }
+      }
+    }
+  }
+  EXPECT_GE(clods, 10U);
+  EXPECT_EQ(pedestrians, static_cast<std::size_t>(setup.rotations));
+  EXPECT_GE(feet_seen, 1U) << "the beams that reach the pedestrian's lower legs are not counted as raised";
+}
+
 // The shed is the dense scene for benchmarks: nearly every ray returns.
 TEST(SimScenes, ShedReturnsNearlyEveryRay) {
   for (const double rate : {10.0, 5.0}) {

@@ -140,6 +140,16 @@ bool get_items(const JsonValue& obj, std::string_view key, bool required, std::v
       return false;
     }
     t.hits = std::lround(hits);
+    double raised = -1.0;
+    if (!get_number(o, "raised_hits", raised, why, false)) {
+      why = where + ": " + why;
+      return false;
+    }
+    if (o.find("raised_hits") != nullptr && !(raised >= 0.0 && raised <= hits)) {
+      why = where + ": \"raised_hits\" must be from 0 to \"hits\"";
+      return false;
+    }
+    t.raised_hits = std::lround(raised);
     t.distance_m = horizontal_distance(t.box);
     if (!get_number(o, "distance_m", t.distance_m, why, false)) {
       why = where + ": " + why;

@@ -42,6 +42,7 @@ struct TruthItem {
   std::string cls;   // pedestrian implement haystack house tree crown | clod ridge crop body
   Box box;
   long hits = 0;
+  long raised_hits = -1;    // returns 0.5 m or more above the surface; -1: the line does not say
   double distance_m = 0.0;  // from the line, or computed from the box if absent
 };
 

@@ -16,7 +16,7 @@ using namespace fieldguard::score;
 
 void usage(std::ostream& os) {
   os << "usage: fieldguard-score --detections FILE --truth FILE [--json] [--margin M] [--min-overlap F]\n"
-        "                        [--min-hits N] [--region X0,Y0,X1,Y1 | --region none] [--include-partial]\n"
+        "                        [--min-hits N] [--min-raised-hits N] [--region X0,Y0,X1,Y1 | --region none] [--include-partial]\n"
         "                        [--tolerance S]\n\n"
         "Scores obstacles (fieldguard replay --obstacles-out: one JSON line per rotation with \"stamp\",\n"
         "\"obstacles\": [{\"min\", \"max\", ...}], optionally \"partial\") against ground truth (fieldguard-sim\n"
@@ -25,6 +25,8 @@ void usage(std::ostream& os) {
         "  --margin M          grow truth boxes by M metres on every side before testing overlap (default 0.3)\n"
 "  --min-overlap F     on x and y the overlap must be at least F of the shorter extent (default 0.5)\n"
         "  --min-hits N        a real object is visible with at least N returns (default 3)\n"
+        "  --min-raised-hits N and at least N of them 0.5 m or more above the field surface under them\n"
+        "                      (default 3; the truth's \"raised_hits\"; 0: any returns count, as before)\n"
         "  --region ...        and only if its box overlaps this x-y rectangle (default -10,-10,50,10: the\n"
         "                      configured region of interest); 'none' for everywhere\n"
         "  --include-partial   also score detection frames marked \"partial\": true (skipped by default)\n"
@@ -100,6 +102,10 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--min-hits") {
       if (!parse_number(v, params.min_hits) || params.min_hits < 1) return bad_usage("--min-hits wants a whole number >= 1, not '" + vs + "'");
+    } else if (a == "--min-raised-hits") {
+      if (!parse_number(v, params.min_raised_hits) || params.min_raised_hits < 0) {
+        return bad_usage("--min-raised-hits wants a whole number >= 0, not '" + vs + "'");
+      }
     } else if (a == "--region") {
       if (v == "none") {
         params.region.reset();
@@ -124,6 +130,16 @@ int main(int argc, char** argv) {
   if (!read_truth(truth_path, truth, error) || !read_detections(detections_path, detections, error)) {
     std::cerr << "fieldguard-score: " << error << "\n";
     return 2;
+  }
+  if (params.min_raised_hits > 0) {
+    for (const TruthFrame& f : truth) {
+      for (const TruthItem& o : f.objects) {
+        if (o.raised_hits >= 0) continue;
+        std::cerr << "fieldguard-score: " << truth_path << ":" << f.line << ": " << o.id
+                  << " has no \"raised_hits\" (truth from an older simulator): score it with --min-raised-hits 0\n";
+        return 2;
+      }
+    }
   }
   const ScoreReport report = score(truth, detections, params);
   std::cout << (json ? format_json(report) + "\n" : format_text(report, detections_path, truth_path));

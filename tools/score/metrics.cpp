@@ -29,7 +29,10 @@ void score_frame(const TruthFrame& t, const DetectionFrame& d, const ScoreParams
   const std::size_t n_obs = d.obstacles.size();
   std::vector<bool> visible(n_obj, false);
   for (std::size_t i = 0; i < n_obj; ++i) {
-    visible[i] = t.objects[i].hits >= p.min_hits && in_region(t.objects[i].box, p);
+    const TruthItem& obj = t.objects[i];
+    // raised_hits is -1 where the truth does not say (allowed only with min_raised_hits 0: see main.cpp).
+    const bool raised = p.min_raised_hits <= 0 || obj.raised_hits >= p.min_raised_hits;
+    visible[i] = obj.hits >= p.min_hits && raised && in_region(obj.box, p);
   }
   // match[o][i]: obstacle o matches object i.
   std::vector<std::vector<bool>> match(n_obs, std::vector<bool>(n_obj, false));

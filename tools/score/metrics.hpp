@@ -6,8 +6,13 @@
 //   `min_overlap` (default 0.5) of the shorter of the two extents on that axis (+5 cm each): see
 //   frames.hpp matches(). So an obstacle on one crown does not also match the next crown 0.3 m away.
 // * A real object (pedestrian, implement, haystack, house, tree, crown) is VISIBLE when it has at least
-//   `min_hits` returns (default 3: fewer cannot make a cluster with an extent) and its box overlaps the
-//   region (default x -10..50, y -10..10 m: the configured ROI; objects outside it cannot be reported).
+//   `min_hits` returns (default 3: fewer cannot make a cluster with an extent), at least `min_raised_hits`
+//   of them (default 3) 0.5 m or more above the field surface under them (the truth's "raised_hits"), and
+//   its box overlaps the region (default x -10..50, y -10..10 m: the configured ROI; objects outside it
+//   cannot be reported). Returns lower than 0.5 m stand where clods, ridges and furrows stand, which the
+//   issue calls terrain: an object seen only there, or by one or two returns above it (a crown seen by
+//   one ray through its foliage and at its trunk's foot), has not shown enough of itself to be told from
+//   terrain or a stray return. `min_raised_hits` 0 gives the rule before it (any `min_hits` returns).
 // * DETECTED: a visible object matched by at least one obstacle. Rates are detected / visible, counted per
 //   (frame, object).
 // * Pedestrian bands: by the pedestrian's distance_m, [0,5), [5,10), ..., [30,35), [35, inf).
@@ -38,6 +43,7 @@ struct ScoreParams {
   double margin_m = 0.3;
   double min_overlap = 0.5;
   long min_hits = 3;
+  long min_raised_hits = 3;  // needs truth with "raised_hits" when above 0
   std::optional<std::array<double, 4>> region = std::array<double, 4>{-10.0, -10.0, 50.0, 10.0};  // x0 y0 x1 y1
   bool include_partial = false;
   std::optional<double> tolerance_s;  // default: half the rotation period

@@ -60,7 +60,8 @@ std::string format_text(const ScoreReport& r, const std::string& detections_path
   }
   s += "match: obstacle box overlaps the truth box grown by " + fixed(r.params.margin_m, 2) + " m (x, y: by >= " +
        fixed(r.params.min_overlap * 100.0, 0) + "% of the shorter extent); visible: >= " +
-       std::to_string(r.params.min_hits) + " returns";
+       std::to_string(r.params.min_hits) + " returns, >= " + std::to_string(r.params.min_raised_hits) +
+       " of them 0.5 m above the surface";
   if (r.params.region) {
     const auto& g = *r.params.region;
     s += ", box in x " + fixed(g[0], 1) + ".." + fixed(g[2], 1) + " y " + fixed(g[1], 1) + ".." + fixed(g[3], 1) + " m";
@@ -92,7 +93,8 @@ std::string format_text(const ScoreReport& r, const std::string& detections_path
 std::string format_json(const ScoreReport& r) {
   std::string s = "{\"params\": {\"margin_m\": " + fixed(r.params.margin_m, 3) +
                   ", \"min_overlap\": " + fixed(r.params.min_overlap, 3) +
-                  ", \"min_hits\": " + std::to_string(r.params.min_hits) + ", \"region\": ";
+                  ", \"min_hits\": " + std::to_string(r.params.min_hits) +
+                  ", \"min_raised_hits\": " + std::to_string(r.params.min_raised_hits) + ", \"region\": ";
   if (r.params.region) {
     const auto& g = *r.params.region;
     s += "[" + fixed(g[0], 3) + ", " + fixed(g[1], 3) + ", " + fixed(g[2], 3) + ", " + fixed(g[3], 3) + "]";

@@ -129,7 +129,13 @@ void Simulator::simulate_packet(std::uint64_t packet, std::uint64_t in_rotation,
       const double intensity = hit.reflectivity * (0.35 + 0.65 * hit.cos_incidence) * (1.0 + 0.1 * u_int);
       blocks[b].returns[j] = {d, static_cast<std::uint8_t>(std::clamp(std::lround(intensity), 1L, 255L))};
       ++tally.returns;
-      if (hit.target >= 0) ++tally.hits[static_cast<std::size_t>(hit.target)];
+      if (hit.target >= 0) {
+        const auto target = static_cast<std::size_t>(hit.target);
+        ++tally.hits[target];
+        // Where the ray really met it (the noise only moves the encoded range), against the surface there.
+        const Vec3 p = pose.position + (pose.rot * directions_[firing]) * hit.range_m;
+        if (p.z - scene_.terrain.height(p.x, p.y) >= kRaisedM) ++tally.raised[target];
+      }
     }
   }
   const std::int64_t abs_us = absolute_ns(tp_ns + hdl32e::kLastFiringNs) / 1000;
@@ -148,7 +154,10 @@ FrameTruth Simulator::rotation(std::uint64_t k, std::vector<TimedPacket>& out) {
   const std::size_t first = out.size();
   out.resize(first + ppr);
   std::vector<Tally> tallies(threads_);
-  for (Tally& t : tallies) t.hits.assign(caster_.target_count(), 0);
+  for (Tally& t : tallies) {
+    t.hits.assign(caster_.target_count(), 0);
+    t.raised.assign(caster_.target_count(), 0);
+  }
   auto work = [&](unsigned w) {
     for (std::uint64_t i = w; i < ppr; i += threads_) simulate_packet(k * ppr + i, i, out[first + i], tallies[w]);
   };
@@ -161,9 +170,13 @@ FrameTruth Simulator::rotation(std::uint64_t k, std::vector<TimedPacket>& out) {
     for (std::thread& t : pool) t.join();
   }
   hits_.assign(caster_.target_count(), 0);
+  raised_.assign(caster_.target_count(), 0);
   for (const Tally& t : tallies) {
     truth.returns += t.returns;
-    for (std::size_t i = 0; i < hits_.size(); ++i) hits_[i] += t.hits[i];
+    for (std::size_t i = 0; i < hits_.size(); ++i) {
+      hits_[i] += t.hits[i];
+      raised_[i] += t.raised[i];
+    }
   }
 
   truth.frame = k;
@@ -186,6 +199,7 @@ FrameTruth Simulator::rotation(std::uint64_t k, std::vector<TimedPacket>& out) {
     t.id = o.id;
     t.cls = o.cls;
     t.hits = hits_[i];
+    t.raised_hits = raised_[i];
     (terrain ? truth.terrain : truth.objects).push_back(std::move(t));
   }
   for (std::size_t c = 0; c < scene_.crops.size(); ++c) {
@@ -195,6 +209,7 @@ FrameTruth Simulator::rotation(std::uint64_t k, std::vector<TimedPacket>& out) {
     t.id = "crop-" + std::to_string(c + 1);
     t.cls = ObjectClass::Crop;
     t.hits = h;
+    t.raised_hits = raised_[static_cast<std::size_t>(caster_.crop_target(c))];
     truth.terrain.push_back(std::move(t));
   }
   if (const std::uint32_t h = hits_[static_cast<std::size_t>(caster_.body_target())]; h > 0) {
@@ -203,6 +218,7 @@ FrameTruth Simulator::rotation(std::uint64_t k, std::vector<TimedPacket>& out) {
     t.cls = ObjectClass::Body;
     for (const Primitive& p : scene_.body) t.box.add(bounds(p));
     t.hits = h;
+    t.raised_hits = raised_[static_cast<std::size_t>(caster_.body_target())];
     t.distance_m = horizontal_distance(t.box);
     truth.terrain.push_back(std::move(t));
   }

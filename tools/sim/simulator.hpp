@@ -29,6 +29,11 @@ struct SimSettings {
                                    // depend on it (0 = one per hardware thread, at most 8)
 };
 
+// A return this high above the field surface under it is obstacle evidence; lower ones stand where clods,
+// ridges and furrows stand, which the height rule (0.5 m) calls terrain. The truth counts them
+// apart so that the scorer can ask whether an object showed enough of itself above that height.
+inline constexpr double kRaisedM = 0.5;
+
 struct TimedPacket {
   PacketBytes bytes{};
   std::int64_t pcap_time_ns = 0;  // whole microseconds
@@ -40,6 +45,7 @@ struct ObjectTruth {
   Aabb box;                  // sensor frame, when the sensor's beam swept the object's centre; for an object
                              // across azimuth 0, the union of where it was at the rotation's start and end
   std::uint32_t hits = 0;    // returns on it in this rotation (after dropouts)
+  std::uint32_t raised_hits = 0;  // of those, the ones kRaisedM or more above the field surface under them
   double distance_m = 0.0;   // horizontal, sensor origin -> nearest point of `box`
 };
 
@@ -76,6 +82,7 @@ class Simulator {
   // What one thread gathers over its packets of a rotation.
   struct Tally {
     std::vector<std::uint32_t> hits;  // by ray-caster target
+    std::vector<std::uint32_t> raised;  // by ray-caster target: hits kRaisedM or more above the surface
     std::uint64_t returns = 0;
     SceneObject moving;               // this thread's copy of the pedestrian
   };
@@ -92,6 +99,7 @@ class Simulator {
   std::vector<Vec3> directions_;  // sensor-frame ray of every firing of a rotation, [block * 32 + laser]
   std::vector<CastHit> body_;     // the tractor's body along each of them
   std::vector<std::uint32_t> hits_;
+  std::vector<std::uint32_t> raised_;
   std::vector<Aabb> swept_;
   unsigned threads_ = 1;
 };

@@ -33,7 +33,8 @@ void append_objects(std::string& s, const std::vector<ObjectTruth>& list) {
     append_vec(s, o.box.min);
     s += ", \"max\": ";
     append_vec(s, o.box.max);
-    s += ", \"hits\": " + std::to_string(o.hits) + ", \"distance_m\": ";
+    s += ", \"hits\": " + std::to_string(o.hits) + ", \"raised_hits\": " + std::to_string(o.raised_hits) +
+         ", \"distance_m\": ";
     append_number(s, o.distance_m, 3);
     s += '}';
   }

@@ -3,9 +3,11 @@
 //   {"frame": k, "stamp": <pcap time of the rotation's first packet, s>, "period_s": p,
 //    "roll_deg": r, "pitch_deg": q, "sensor_world": [x, y, z], "returns": n,
 //    "objects": [{"id": "...", "class": "pedestrian|implement|haystack|house|tree|crown",
-//                 "min": [x,y,z], "max": [x,y,z], "hits": n, "distance_m": d}, ...],
+//                 "min": [x,y,z], "max": [x,y,z], "hits": n, "raised_hits": r, "distance_m": d}, ...],
 //    "terrain": [{"id": "...", "class": "clod|ridge|crop|body", "min": [...], "max": [...], "hits": n,
-//                 "distance_m": d}, ...]}
+//                 "raised_hits": r, "distance_m": d}, ...]}
+// raised_hits: those of the hits that stood kRaisedM (0.5 m) or more above the field surface under them
+// (the true surface point, before range noise): what the object showed of itself above terrain height.
 // Boxes in the sensor frame (x forward, y left, z up, m): the axis-aligned bounds of the object's world
 // box rotated into the sensor's attitude at the moment the beam swept the object's centre (for an object
 // across azimuth 0, straight ahead, the union of its boxes at the rotation's first and last packet: the
