@@ -54,9 +54,10 @@ class ScoreCli : public ::testing::Test {
     write_file(dir_.file("truth.jsonl"), kTruth);
     write_file(dir_.file("det.jsonl"), kDetections);
   }
-  [[nodiscard]] JsonValue score_json(const std::string& extra = "") const {
-    const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file("det.jsonl") + " --truth " +
-                                             dir_.file("truth.jsonl") + extra);
+  [[nodiscard]] JsonValue score_json(const std::string& extra = "", const std::string& detections = "det.jsonl",
+                                     const std::string& truth = "truth.jsonl") const {
+    const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file(detections) + " --truth " +
+                                             dir_.file(truth) + extra);
     EXPECT_EQ(r.exit_code, 0) << r.errors;
     const auto parsed = parse_json(r.output);
     EXPECT_TRUE(parsed.value) << r.output;
@@ -163,12 +164,7 @@ TEST_F(ScoreCli, ReturnsBelowTerrainHeightDoNotMakeAnObjectVisible) {
   write_file(dir_.file("raised.det.jsonl"),
              R"({"frame": 0, "stamp": 200.0, "obstacles": [{"min": [20.2, -3.8, 0.5], "max": [21.8, -2.2, 1.9]}]})"
              "\n");
-  const auto score = [&](const std::string& extra) {
-    const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file("raised.det.jsonl") + " --truth " +
-                                             dir_.file("raised.truth.jsonl") + extra);
-    EXPECT_EQ(r.exit_code, 0) << r.errors;
-    return parse_json(r.output).value.value_or(JsonValue{});
-  };
+  const auto score = [&](const std::string& extra) { return score_json(extra, "raised.det.jsonl", "raised.truth.jsonl"); };
   const JsonValue v = score("");
   EXPECT_EQ(num(v, {"params", "min_raised_hits"}), 3);
   EXPECT_EQ(num(v, {"crowns", "visible"}), 1);
@@ -192,10 +188,8 @@ TEST_F(ScoreCli, TruthWithoutRaisedHitsIsRefusedUnlessTheOldRuleIsAsked) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("old.truth.jsonl:1: p has no \"raised_hits\""), std::string::npos) << r.errors;
   EXPECT_NE(r.errors.find("--min-raised-hits 0"), std::string::npos) << r.errors;
-  r = run(FIELDGUARD_SCORE, "--json --min-raised-hits 0 --detections " + dir_.file("det.jsonl") + " --truth " +
-                                dir_.file("old.truth.jsonl"));
-  EXPECT_EQ(r.exit_code, 0) << r.errors;
-  EXPECT_EQ(num(parse_json(r.output).value.value_or(JsonValue{}), {"classes", "pedestrian", "detected"}), 1);
+  EXPECT_EQ(num(score_json(" --min-raised-hits 0", "det.jsonl", "old.truth.jsonl"), {"classes", "pedestrian", "detected"}),
+            1);
 
   write_file(dir_.file("more.truth.jsonl"),
              R"({"frame": 0, "stamp": 100.0, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 4, "raised_hits": 5}]})"
