@@ -665,6 +665,7 @@ void BM_PacketsToObstacles(benchmark::State& state) {
   velodyne::Stream stream(bench::sim_stream_options());
   Pipeline pipe(fieldguard_params());
   std::vector<LidarFrame> done;
+  std::vector<StageTimes> times;  // the pipeline's own stage times of every rotation processed
   std::size_t processed = 0, obstacles = 0;
   const auto run = [&] {
     for (auto& d : done) stream.recycle(std::move(d));
@@ -673,14 +674,31 @@ void BM_PacketsToObstacles(benchmark::State& state) {
     for (const auto& d : done) {
       const auto r = pipe.process(d.points);
       obstacles = r.obstacles.size();
+      times.push_back(r.times);
       ++processed;
       benchmark::DoNotOptimize(r.obstacles.data());
     }
   };
   run();  // the first push only starts a rotation
+  times.clear();
   paired(state, "PACKETS -> obstacles", static_cast<int>(state.range(0)), f.points.size(), run, {});
   state.counters["obstacles"] = static_cast<double>(obstacles);
   if (processed == 0) state.SkipWithError("velodyne::Stream emitted no rotation");
+  // Each stage as it ran here, after decoding and after the last rotation (medians, steady clock): what the
+  // stage benches above time on one frame repeated, warm.
+  const auto stage = [&](const char* name, float StageTimes::*field) {
+    std::vector<double> v;
+    v.reserve(times.size());
+    for (const StageTimes& t : times) v.push_back(static_cast<double>(t.*field));
+    state.counters[name] = median(v);
+  };
+  stage("in_crop_us", &StageTimes::crop_us);
+  stage("in_voxel_us", &StageTimes::voxel_us);
+  stage("in_ground_us", &StageTimes::ground_us);
+  stage("in_cluster_us", &StageTimes::cluster_us);
+  stage("in_merge_us", &StageTimes::merge_us);
+  stage("in_boxes_us", &StageTimes::boxes_us);
+  stage("in_pipeline_us", &StageTimes::total_us);
 }
 
 // Decoding alone: the same packets into velodyne::Stream.

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/args.hpp"
 #include "app/bev.hpp"
@@ -112,6 +114,23 @@ std::string fmt_rmc(const nmea::Rmc& r) {
                 r.year.value_or(0), r.month.value_or(0), r.day.value_or(0), r.lat_deg.value_or(0.0),
                 r.lon_deg.value_or(0.0));
   return buf;
+}
+
+// The median time of the pipeline a frame, and of each stage (each median on its own: they need not add up).
+void print_stage_times(const std::vector<perception::StageTimes>& times) {
+  if (times.empty()) return;
+  std::vector<float> v(times.size());
+  const auto median_ms = [&](float perception::StageTimes::*field) {
+    for (std::size_t i = 0; i < times.size(); ++i) v[i] = times[i].*field;
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return static_cast<double>(*mid) * 1e-3;
+  };
+  using T = perception::StageTimes;
+  std::printf("  pipeline time     median %.3f ms a frame: crop %.3f, voxel %.3f, ground %.3f, clusters %.3f, merge %.3f, "
+              "boxes %.3f, near field %.3f\n",
+              median_ms(&T::total_us), median_ms(&T::crop_us), median_ms(&T::voxel_us), median_ms(&T::ground_us),
+              median_ms(&T::cluster_us), median_ms(&T::merge_us), median_ms(&T::boxes_us), median_ms(&T::near_us));
 }
 
 void print_summary(const std::string& pcap, const io::PcapStats& ps, const velodyne::Stream& stream,
@@ -315,6 +334,7 @@ int cmd_replay(const std::vector<std::string>& argv) {
   std::optional<DetectorSet> detectors;
   if (detect || fusion.fused()) detectors.emplace(cfg, workers);
   std::uint64_t obstacles_total = 0;
+  std::vector<perception::StageTimes> times;  // each frame's, for the summary
   std::array<HeardTimes, 3> heard;  // scan2d, gnss, ahrs: LogKind order
   // Implausible GNSS / AHRS samples, by receive time: each goes to the first decision at or after it.
   struct TimedProblem {
@@ -374,6 +394,7 @@ int cmd_replay(const std::vector<std::string>& argv) {
     if (!detect) return;
     const perception::FrameResult& result = r.output->det.result;
     obstacles_total += result.obstacles.size();
+    times.push_back(result.times);
     if (obstacles_out.is_open() && write_error.empty()) {
       obstacles_out << obstacles_json_line(f, result, fused, &cfg.lidar.mounting) << '\n';
       if (!obstacles_out) write_error = "cannot write " + *args.get("obstacles-out");
@@ -494,7 +515,10 @@ int cmd_replay(const std::vector<std::string>& argv) {
   const io::PcapStats& pcap_stats = recording->capture().stats();
   print_summary(pcap_path, pcap_stats, stream, pos, ports, written, wall_s,
                 static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
-  if (detect) std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+  if (detect) {
+    std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+    print_stage_times(times);
+  }
   std::printf("  workers           %zu, %llu frames lost\n", workers, static_cast<unsigned long long>(lost));
   if (can) {
     const auto& cc = can->counts();

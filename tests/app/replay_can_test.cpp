@@ -83,6 +83,12 @@ void expect_identical_for_any_workers(const std::string& pcap, std::size_t rotat
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("workers           " + std::to_string(counts[i]) + ", 0 frames lost"), std::string::npos)
         << r.output;
+    // The summary's pipeline time: a median above zero, and each stage's after it.
+    const std::string timed = "  pipeline time     median ";
+    const auto at = r.output.find(timed);
+    ASSERT_NE(at, std::string::npos) << r.output;
+    EXPECT_GT(std::stod(r.output.substr(at + timed.size())), 0.0) << r.output;
+    EXPECT_NE(r.output.find(", voxel ", at), std::string::npos) << r.output;
     obstacles[i] = slurp(o);
     can[i] = slurp(c);
     if (bev) {

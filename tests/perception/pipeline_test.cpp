@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -124,6 +125,29 @@ TEST(Pipeline, ObstaclesNearestFirstAndCountsAddUp) {
     EXPECT_GE(o.height_above_ground_m, 0.5F);  // fieldguard.yaml's height filter
     EXPECT_GE(o.obb_length_m, o.obb_width_m);
   }
+}
+
+// The stage times: each stage that worked on the frame took some time, they add up to the whole (nothing timed
+// twice or left out), and the whole is within the time the call took, seen from outside.
+TEST(Pipeline, StageTimesAddUpToTheFrame) {
+  Pipeline pipe(PipelineParams{});
+  const auto before = std::chrono::steady_clock::now();
+  const FrameResult r = pipe.process(field_scan());
+  const double outside_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - before).count();
+  ASSERT_GT(r.obstacles.size(), 0U);
+  const StageTimes& t = r.times;
+  for (const float us : {t.crop_us, t.voxel_us, t.ground_us, t.cluster_us, t.merge_us, t.boxes_us}) EXPECT_GT(us, 0.F);
+  EXPECT_GE(t.near_us, 0.F);
+  double sum = 0.0;
+  for (const float us : {t.crop_us, t.voxel_us, t.ground_us, t.cluster_us, t.merge_us, t.boxes_us, t.near_us}) {
+    sum += static_cast<double>(us);
+  }
+  EXPECT_NEAR(sum, static_cast<double>(t.total_us), 1e-3 * static_cast<double>(t.total_us) + 0.01);
+  EXPECT_LE(static_cast<double>(t.total_us), outside_us);
+  // An empty frame still reports its (tiny) whole.
+  const FrameResult none = pipe.process({});
+  EXPECT_GE(none.times.total_us, 0.F);
+  EXPECT_LT(none.times.total_us, t.total_us);
 }
 
 // The labelled points are the voxels, in their order and to the bit, Ground exactly where the ground stage says
