@@ -170,8 +170,19 @@ inline std::size_t crop_points(const LidarPoint* in, std::size_t n, const BoxBou
   // Eight at a time: one source test and one loop step for two fours.
   static_assert(static_cast<std::uint8_t>(PointSource::Lidar3d) == 0);
   std::size_t i = 0;
+  constexpr std::size_t kAhead = 512;  // points: 16 kB
   for (; i + 8 <= n; i += 8) {
     const LidarPoint* const p = in + i;
+    // The eight's four cache lines kAhead points ahead (the last point's line near the end), fetched now. In
+    // the daemon's path the frame comes from the decoder, out of the near caches, and the hardware prefetcher
+    // did not run far enough ahead of this loop: BM_PacketsToObstacles' crop took 0.24-0.31 ms without and
+    // 0.17-0.19 ms with (a distance of 128 to 4,096 points measured alike; none helps the crop's own, warm,
+    // benchmark).
+    const char* const later = reinterpret_cast<const char*>(in + std::min(i + kAhead, n - 8));
+    __builtin_prefetch(later);
+    __builtin_prefetch(later + 64);
+    __builtin_prefetch(later + 128);
+    __builtin_prefetch(later + 192);
     if constexpr (split) {
       // One OR of the sources instead of a comparison each: any source but the 3D LiDAR's (0) sends the eight
       // to the point-by-point path, which tells the 2D LiDAR's exactly.
