@@ -9,6 +9,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -279,6 +280,17 @@ class Session {
       if (auto w = sy->waiting_for(now)) line += " | sync waiting for " + std::string(sync::to_string(*w));
     }
     if (stalled_) line += " | pipeline stalled";
+    if (!pipeline_us_.empty()) {
+      // The last rotations' detection times (one worker's, per rotation): headroom against the frame period.
+      std::vector<float> v(pipeline_us_.begin(), pipeline_us_.end());
+      const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+      std::nth_element(v.begin(), mid, v.end());
+      const float worst = *std::max_element(v.begin(), v.end());
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " | detection %.1f ms (max %.1f) over %zu rotations", static_cast<double>(*mid) * 1e-3,
+                    static_cast<double>(worst) * 1e-3, v.size());
+      line += buf;
+    }
     return line;
   }
 
@@ -377,6 +389,8 @@ class Session {
       return;
     }
     pass_problems();
+    if (pipeline_us_.size() == kTimedRotations) pipeline_us_.pop_front();
+    pipeline_us_.push_back(r.output->result.times.total_us);
     stage_.frame(r.output->frame, r.output->result, r.input->complete, wall_clock_now(), lost_);
     if (ready_) notify_.progress(SteadyClock::now());
   }
@@ -398,6 +412,8 @@ class Session {
   std::vector<std::unique_ptr<io::SerialReader>> serial_;
   std::vector<FrameJob> jobs_;
   std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
+  static constexpr std::size_t kTimedRotations = 50;  // the status's detection times: the last 5 s at 10 Hz
+  std::deque<float> pipeline_us_;  // Pipeline::process() of the last rotations delivered, oldest first
   std::uint64_t lost_ = 0;       // rotations dropped, refused or failed
   std::uint64_t bad_length_ = 0;
   bool heard_all_ = false;

@@ -565,6 +565,14 @@ TEST_F(RunE2e, NotifyReadyThenWatchdogWhileHealthyAndNoneWhileAWorkerHangs) {
   EXPECT_EQ(count_with(msgs, "READY=1"), 1);
   EXPECT_GE(count_with(msgs, "WATCHDOG=1"), 3) << daemon.output();
   EXPECT_LE(count_with(msgs, "WATCHDOG=1"), 8);
+  // Rotations detected by now: the status says how long detection takes (median, max, how many rotations).
+  const auto timed = std::find_if(msgs.begin(), msgs.end(), [](const std::string& m) {
+    return m.find("STATUS=") != std::string::npos && m.find(" | detection ") != std::string::npos;
+  });
+  ASSERT_NE(timed, msgs.end()) << daemon.output();
+  const std::string after = timed->substr(timed->find(" | detection ") + 13);
+  EXPECT_GT(std::stod(after), 0.0) << *timed;
+  EXPECT_NE(after.find(" ms (max "), std::string::npos) << *timed;
 
   // Hang the worker: ptrace-stop that one thread (PTRACE_INTERRUPT stops the tracee alone; the io thread
   // goes on receiving, deciding and sending). Rotations pile up behind it, as behind a worker stuck in a
