@@ -385,6 +385,70 @@ TEST(EuclideanClusterer, GridTailsAndShortRunsMatchTheKdTree) {
   }
 }
 
+// A point on the cloud's upper bound whose cell, computed in float, rounds up to one past the grid's last (the
+// grid's cell count comes from the same span in double): it must land in the last cell, on x and on z, four at a
+// time (the first four points) as one by one. The spans that do this are searched for here with the grid's cell
+// edge for a 0.6 m radius (euclidean_cluster.cpp: the radius less the rounding allowance, over sqrt 3); should
+// that formula change, the search finds none and the test says so.
+TEST(EuclideanClusterer, GridPointOnTheUpperBoundStaysInTheLastCell) {
+  const auto edge_for = [](float t, float extent) {
+    const float rounding = 8.F * extent * std::numeric_limits<float>::epsilon() + 1e-3F;
+    return (t * 0.999F - 2.F * rounding) / std::numbers::sqrt3_v<float>;
+  };
+  // Whether a span's float cell index is the count of cells the double division gives (one past the last).
+  const auto past_the_last = [](float span, float edge) {
+    const auto cells = static_cast<std::size_t>(static_cast<double>(span) / static_cast<double>(edge)) + 1;
+    return static_cast<std::size_t>(static_cast<std::int32_t>(span * (1.F / edge))) >= cells;
+  };
+  // The floats about k edges long (the edge guessed from an extent near it when the span sets the extent), for k in
+  // [k0, k1): the first that is one past the last, or 0.
+  const auto find_span = [&](float t, int k0, int k1, bool sets_extent, float extent) {
+    for (int k = k0; k < k1; ++k) {
+      const float guess = edge_for(t, sets_extent ? static_cast<float>(k) * t / 1.7F : extent);
+      auto span = static_cast<float>(k * static_cast<double>(guess));
+      for (int step = 0; step < 32; ++step) span = std::nextafter(span, 1e9F);
+      for (int step = 0; step < 64; ++step, span = std::nextafter(span, 0.F)) {
+        if (past_the_last(span, edge_for(t, sets_extent ? span : extent))) return span;
+      }
+    }
+    return 0.F;
+  };
+  int cases = 0;
+  for (int i = 0; i < 60 && cases < 3; ++i) {
+    const float t = 0.3F + 0.01F * static_cast<float>(i);
+    const float x_span = find_span(t, 40, 120, true, 0.F);  // x sets the extent, so the edge
+    if (x_span == 0.F) continue;
+    const float z_span = find_span(t, 3, 40, false, x_span);
+    if (z_span == 0.F) continue;
+    ++cases;
+    for (const bool in_first_four : {true, false}) {
+      // A row along x from 0 to x_span, 0.2 m apart (one cluster), a column at its far end up to z_span, and
+      // an isolated point; the two corner points on the upper bounds among the first four or the last ones.
+      Cloud c;
+      const auto corners = [&] {
+        c.push_back(x_span, 0.F, 0.F);
+        c.push_back(x_span, 0.F, z_span);
+      };
+      if (in_first_four) corners();
+      c.push_back(0.F, 0.F, 0.F);
+      c.push_back(x_span * 0.5F, 3.F, 0.F);  // alone
+      for (float x = 0.2F; x < x_span; x += 0.2F) c.push_back(x, 0.F, 0.F);
+      for (float z = 0.2F; z < z_span; z += 0.2F) c.push_back(x_span, 0.F, z);
+      if (!in_first_four) {
+        // Past the last full four (one by one): points on the row's start until the count is a multiple of four.
+        for (float x = 0.05F; c.size() % 4 != 0; x += 0.05F) c.push_back(x, 0.F, 0.F);
+        corners();
+      }
+      Clusters kd_out, grid_out;
+      EuclideanClusterer(params(ClusterMethod::Fixed, ClusterStructure::KdTree, t)).extract(c, kd_out);
+      EuclideanClusterer(params(ClusterMethod::Fixed, ClusterStructure::Grid, t)).extract(c, grid_out);
+      EXPECT_EQ(sets_of(grid_out), sets_of(kd_out)) << "radius " << t << ", x span " << x_span << ", z span " << z_span;
+      EXPECT_EQ(kd_out.size(), 2U);
+    }
+  }
+  EXPECT_GT(cases, 0) << "no span rounds up to one past the last cell: has the grid's cell edge changed?";
+}
+
 // Far out the grid stacks z cells into taller ones (the radii are large there): two vertical runs of points
 // 30 m out join across a gap just under the vertical radius and stay apart across one just over it, and dense
 // far clouds give the k-d tree's clusters, for both growing radii.
