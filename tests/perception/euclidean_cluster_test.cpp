@@ -440,8 +440,10 @@ TEST(EuclideanClusterer, GridPointOnTheUpperBoundStaysInTheLastCell) {
         corners();
       }
       Clusters kd_out, grid_out;
-      EuclideanClusterer(params(ClusterMethod::Fixed, ClusterStructure::KdTree, t)).extract(c, kd_out);
-      EuclideanClusterer(params(ClusterMethod::Fixed, ClusterStructure::Grid, t)).extract(c, grid_out);
+      const ClusterParams kd = params(ClusterMethod::Fixed, ClusterStructure::KdTree, static_cast<double>(t));
+      const ClusterParams grid = params(ClusterMethod::Fixed, ClusterStructure::Grid, static_cast<double>(t));
+      EuclideanClusterer(kd).extract(c, kd_out);
+      EuclideanClusterer(grid).extract(c, grid_out);
       EXPECT_EQ(sets_of(grid_out), sets_of(kd_out)) << "radius " << t << ", x span " << x_span << ", z span " << z_span;
       EXPECT_EQ(kd_out.size(), 2U);
     }
