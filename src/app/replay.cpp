@@ -28,6 +28,7 @@
 #include "app/png_writer.hpp"
 #include "app/recording.hpp"
 #include "app/samples.hpp"
+#include "app/stage_times.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/app/config.hpp"
@@ -122,9 +123,7 @@ void print_stage_times(const std::vector<perception::StageTimes>& times) {
   std::vector<float> v(times.size());
   const auto median_ms = [&](float perception::StageTimes::*field) {
     for (std::size_t i = 0; i < times.size(); ++i) v[i] = times[i].*field;
-    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return static_cast<double>(*mid) * 1e-3;
+    return static_cast<double>(median_of(v)) * 1e-3;
   };
   using T = perception::StageTimes;
   std::printf("  pipeline time     median %.3f ms a frame: crop %.3f, voxel %.3f, ground %.3f, clusters %.3f, merge %.3f, "

@@ -26,6 +26,7 @@
 #include "app/logging.hpp"
 #include "app/run_stage.hpp"
 #include "app/samples.hpp"
+#include "app/stage_times.hpp"
 #include "app/systemd_notify.hpp"
 #include "app/source_options.hpp"
 #include "fieldguard/app/config.hpp"
@@ -283,12 +284,10 @@ class Session {
     if (!pipeline_us_.empty()) {
       // The last rotations' detection times (one worker's, per rotation): headroom against the frame period.
       std::vector<float> v(pipeline_us_.begin(), pipeline_us_.end());
-      const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-      std::nth_element(v.begin(), mid, v.end());
       const float worst = *std::max_element(v.begin(), v.end());
       char buf[96];
-      std::snprintf(buf, sizeof buf, " | detection %.1f ms (max %.1f) over %zu rotations", static_cast<double>(*mid) * 1e-3,
-                    static_cast<double>(worst) * 1e-3, v.size());
+      std::snprintf(buf, sizeof buf, " | detection %.1f ms (max %.1f) over %zu rotations",
+                    static_cast<double>(median_of(v)) * 1e-3, static_cast<double>(worst) * 1e-3, v.size());
       line += buf;
     }
     return line;
