@@ -117,19 +117,10 @@ std::string fmt_rmc(const nmea::Rmc& r) {
   return buf;
 }
 
-// The median time of the pipeline a frame, and of each stage (each median on its own: they need not add up).
+// The median time of the pipeline a frame, and of each stage.
 void print_stage_times(const std::vector<perception::StageTimes>& times) {
   if (times.empty()) return;
-  std::vector<float> v(times.size());
-  const auto median_ms = [&](float perception::StageTimes::*field) {
-    for (std::size_t i = 0; i < times.size(); ++i) v[i] = times[i].*field;
-    return static_cast<double>(median_of(v)) * 1e-3;
-  };
-  using T = perception::StageTimes;
-  std::printf("  pipeline time     median %.3f ms a frame: crop %.3f, voxel %.3f, ground %.3f, clusters %.3f, merge %.3f, "
-              "boxes %.3f, near field %.3f\n",
-              median_ms(&T::total_us), median_ms(&T::crop_us), median_ms(&T::voxel_us), median_ms(&T::ground_us),
-              median_ms(&T::cluster_us), median_ms(&T::merge_us), median_ms(&T::boxes_us), median_ms(&T::near_us));
+  std::printf("  pipeline time     %s\n", stage_times_line(times).c_str());
 }
 
 void print_summary(const std::string& pcap, const io::PcapStats& ps, const velodyne::Stream& stream,

@@ -281,9 +281,10 @@ class Session {
       if (auto w = sy->waiting_for(now)) line += " | sync waiting for " + std::string(sync::to_string(*w));
     }
     if (stalled_) line += " | pipeline stalled";
-    if (!pipeline_us_.empty()) {
+    if (!timed_.empty()) {
       // The last rotations' detection times (one worker's, per rotation): headroom against the frame period.
-      std::vector<float> v(pipeline_us_.begin(), pipeline_us_.end());
+      std::vector<float> v(timed_.size());
+      for (std::size_t i = 0; i < v.size(); ++i) v[i] = timed_[i].total_us;
       const float worst = *std::max_element(v.begin(), v.end());
       char buf[96];
       std::snprintf(buf, sizeof buf, " | detection %.1f ms (max %.1f) over %zu rotations",
@@ -315,6 +316,11 @@ class Session {
                   u(ac.missing[2]), u(ac.missing[3]));
       std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages; errors %llu, %llu, %llu\n",
                   u(fc.scans), u(fc.gnss), u(fc.ahrs), u(fc.scan_errors), u(fc.gnss_errors), u(fc.ahrs_errors));
+    }
+    if (!timed_.empty()) {
+      const std::vector<perception::StageTimes> last(timed_.begin(), timed_.end());
+      std::printf("  pipeline time     %s (the last %zu rotations); worst %.3f ms of all %llu\n",
+                  stage_times_line(last).c_str(), last.size(), static_cast<double>(worst_us_) * 1e-3, u(timed_count_));
     }
   }
 
@@ -388,8 +394,11 @@ class Session {
       return;
     }
     pass_problems();
-    if (pipeline_us_.size() == kTimedRotations) pipeline_us_.pop_front();
-    pipeline_us_.push_back(r.output->result.times.total_us);
+    const perception::StageTimes& t = r.output->result.times;
+    if (timed_.size() == kTimedRotations) timed_.pop_front();
+    timed_.push_back(t);
+    worst_us_ = std::max(worst_us_, t.total_us);
+    ++timed_count_;
     stage_.frame(r.output->frame, r.output->result, r.input->complete, wall_clock_now(), lost_);
     if (ready_) notify_.progress(SteadyClock::now());
   }
@@ -411,8 +420,11 @@ class Session {
   std::vector<std::unique_ptr<io::SerialReader>> serial_;
   std::vector<FrameJob> jobs_;
   std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
-  static constexpr std::size_t kTimedRotations = 50;  // the status's detection times: the last 5 s at 10 Hz
-  std::deque<float> pipeline_us_;  // Pipeline::process() of the last rotations delivered, oldest first
+  // The detection times of the status and the summary: the last 5 s at 10 Hz.
+  static constexpr std::size_t kTimedRotations = 50;
+  std::deque<perception::StageTimes> timed_;  // Pipeline::process()'s of the last rotations delivered, oldest first
+  float worst_us_ = 0.F;                       // the longest process() of the run
+  std::uint64_t timed_count_ = 0;              // rotations delivered
   std::uint64_t lost_ = 0;       // rotations dropped, refused or failed
   std::uint64_t bad_length_ = 0;
   bool heard_all_ = false;

@@ -333,6 +333,20 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   // (d) within a second of SIGTERM (wall time: the issue's own words).
   EXPECT_LT(exit_s, 1.0);
   std::printf("[ measured ] SIGTERM to exit %.3f s\n", exit_s);
+  {
+    // The exit summary's detection times: a median above zero, each stage's after it, and the run's worst.
+    const std::string out = daemon.output();
+    const std::string timed = "  pipeline time     median ";
+    const auto at = out.find(timed);
+    ASSERT_NE(at, std::string::npos) << out;
+    EXPECT_GT(std::stod(out.substr(at + timed.size())), 0.0) << out;
+    const auto line_end = out.find('\n', at);
+    const std::string line = out.substr(at, line_end - at);
+    EXPECT_NE(line.find(", voxel "), std::string::npos) << line;
+    const auto worst = line.find("; worst ");
+    ASSERT_NE(worst, std::string::npos) << line;
+    EXPECT_GT(std::stod(line.substr(worst + 8)), 0.0) << line;
+  }
 
   const auto loaded = app::load_config_file(config.string());
   ASSERT_TRUE(loaded.ok());
