@@ -346,6 +346,7 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     const auto worst = line.find("; worst ");
     ASSERT_NE(worst, std::string::npos) << line;
     EXPECT_GT(std::stod(line.substr(worst + 8)), 0.0) << line;
+    std::printf("[ measured ] %s\n", line.substr(2).c_str());
   }
 
   const auto loaded = app::load_config_file(config.string());
