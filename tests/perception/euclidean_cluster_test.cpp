@@ -451,6 +451,67 @@ TEST(EuclideanClusterer, GridPointOnTheUpperBoundStaysInTheLastCell) {
   EXPECT_GT(cases, 0) << "no span rounds up to one past the last cell: has the grid's cell edge changed?";
 }
 
+// Within a column, each cell looks down at the cells below it and stops at the first one under its stencil's lowest
+// z cell, `reach` z cells below its own (euclidean_cluster.cpp: reach = (radius + 1 mm) / edge, rounded down, + 1).
+// A cell exactly `reach` z cells below may still hold a point within the radius: its top and the looking cell's
+// bottom are reach - 1 edges apart, which is mostly under the radius (by less than an edge). So the look must go
+// down to that cell too. The case: three points in one column 2 m out (near enough that its z cells are not
+// stacked) and 14 m and more high, so that every radius (and the stencil) is the 1.2 m cap. From the bottom: q, p
+// and a. a is 1.2 m less 4 mm above q, so the two join;
+// q sits near the top of its z cell and a just above the bottom of its own, `reach` z cells apart. p is just under
+// a's z cell, at the column's opposite corner: it joins a, not q. a's nearest cell below is p, which is not in q's
+// cluster, so a must go on down to q: that look alone makes the three one cluster. A lone point far off is the
+// lowest point (so the z cells count from it, and q need not start a cell) and the farthest (so it sets the extent,
+// and with it the edge). The radii for which this holds are searched for with the grid's cell edge and stencil
+// formula; should those change, the search finds none and the test says so.
+TEST(EuclideanClusterer, GridColumnLookReachesTheStencilsLowestCell) {
+  const float cap = 1.2F;  // params(): the adaptive radius cap
+  const float z0 = 14.F;   // the lone point's height
+  const float s = 0.004F;
+  int cases = 0;
+  for (int i = 0; i <= 30; ++i) {
+    const float t = 0.3F + 0.01F * static_cast<float>(i);
+    ClusterParams kd = params(ClusterMethod::Adaptive, ClusterStructure::KdTree, static_cast<double>(t));
+    kd.beam_factor = 4.0;  // 0.093 m per metre of range: the cap from 13 m on
+    ClusterParams grid = kd;
+    grid.structure = ClusterStructure::Grid;
+    // The grid's cell edge (the extent is 20: the lone point's x) and a cell's stencil depth in z cells at the cap.
+    const float rounding = 8.F * 20.F * std::numeric_limits<float>::epsilon() + 1e-3F;
+    const float edge = (t * 0.999F - 2.F * rounding) / std::numbers::sqrt3_v<float>;
+    const float inv = 1.F / edge;
+    const auto reach = static_cast<std::int32_t>((cap + 1e-3F) * inv) + 1;
+    const auto cell = [inv](float v, float origin) { return static_cast<std::int32_t>((v - origin) * inv); };
+    const float bottom = z0 + 8.F * edge;  // a's z cell's bottom, about
+    const float w = 0.9F * edge;           // p's offset from q and a on x and on y
+    Cloud c;
+    c.push_back(2.F, 0.F, bottom - cap + 2.F * s);  // q
+    c.push_back(2.F + w, w, bottom - s);             // p
+    c.push_back(2.F, 0.F, bottom + s);               // a
+    c.push_back(20.F, 0.F, z0);                      // alone
+    // Whether two points join at the cap, as the pair tests compute it.
+    const auto joins = [&](std::size_t m, std::size_t n) {
+      const float dx = c.x[n] - c.x[m], dy = c.y[n] - c.y[m], dz = c.z[n] - c.z[m];
+      return dx * dx + dy * dy + dz * dz < cap * cap;
+    };
+    const EuclideanClusterer probe(kd);
+    const bool all_capped = probe.radius_at(std::sqrt(c.x[0] * c.x[0] + c.z[0] * c.z[0])) == cap;  // q: the nearest
+    const bool one_column = cell(c.x[1], 2.F) == 0 && cell(c.y[1], 0.F) == 0;
+    const std::int32_t qz = cell(c.z[0], z0), pz = cell(c.z[1], z0), az = cell(c.z[2], z0);
+    if (!all_capped || !one_column || az - qz != reach || az - pz != 1 || !joins(0, 2) || !joins(1, 2) ||
+        joins(0, 1)) {
+      continue;
+    }
+    ++cases;
+    Clusters kd_out, grid_out;
+    EuclideanClusterer(kd).extract(c, kd_out);
+    EuclideanClusterer(grid).extract(c, grid_out);
+    const ClusterSets expected = {{0U, 1U, 2U}, {3U}};
+    EXPECT_EQ(sets_of(kd_out), expected) << "radius " << t;
+    EXPECT_EQ(sets_of(grid_out), expected) << "radius " << t << ", edge " << edge << ", reach " << reach;
+  }
+  EXPECT_GT(cases, 0) << "no radius puts q exactly at the bottom of a's stencil: has the grid's cell edge changed?";
+}
+
 // Far out the grid stacks z cells into taller ones (the radii are large there): two vertical runs of points
 // 30 m out join across a gap just under the vertical radius and stay apart across one just over it, and dense
 // far clouds give the k-d tree's clusters, for both growing radii.
