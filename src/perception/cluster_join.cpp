@@ -24,6 +24,7 @@ void check_length(double v, const char* what) {
 ClusterJoiner::ClusterJoiner(const ClusterJoinParams& params) : params_(params) {
   check_length(params.float_height_m, "float_height_m");
   check_length(params.gap_m, "gap_m");
+  check_length(params.fragment_gap_m, "fragment_gap_m");
   check_length(params.stack_margin_m, "stack_margin_m");
 }
 
@@ -54,8 +55,8 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
                                   Clusters& clusters, Buffer<ClusterBounds>* bounds) {
   const std::size_t nc = clusters.size();
   if (bounds != nullptr && bounds->size() != nc) throw std::invalid_argument("ClusterJoiner: one bounds per cluster");
-  const bool fragments = params_.gap_m > 0.0;
-  if (!(params_.float_height_m > 0.0) || (!fragments && !params_.stacked) || nc < 2) return 0;
+  const bool fragments = params_.fragment_gap_m > 0.0, attach = params_.gap_m > 0.0;
+  if (!(params_.float_height_m > 0.0) || (!fragments && !attach && !params_.stacked) || nc < 2) return 0;
   const std::size_t n = cloud.size();
   if (height_m.size() < n) throw std::out_of_range("ClusterJoiner: fewer heights than points");
   const auto float_h = static_cast<float>(params_.float_height_m);
@@ -114,13 +115,18 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
   };
 
   if (fragments) {
-    const auto gap = static_cast<float>(params_.gap_m);
-    // 1. Fragments with fragments.
+    // 1. Fragments with fragments: over a wider gap than rule 2's (fieldguard.yaml: 1.0 against 0.6 m). A group of
+    // fragments is a handful of returns, no obstacle alone; widening rule 2's gap instead bridges neighbouring
+    // crowns through the fragments between them.
+    const auto gap = static_cast<float>(params_.fragment_gap_m);
     sweep([&](std::size_t c) { return !info_[c].empty && info_[c].small; }, gap,
           [&](std::uint32_t a, std::uint32_t b) {
             if (!(info_[a].floats || info_[b].floats) || gap_between(a, b) > gap) return;
             joined += unite(a, b) ? 1U : 0U;
           });
+  }
+  if (attach) {
+    const auto gap = static_cast<float>(params_.gap_m);
     // 2. Each group with a floating fragment: to its one nearest cluster with enough points. Every group's choice is
     // made before any is applied, on the groups of step 1.
     attach_.assign(nc, kNone);

@@ -34,9 +34,11 @@ std::vector<float> heights_of(const Cloud& c) { return {c.z.begin(), c.z.end()};
 // The filters of config/fieldguard.yaml: at 10 m a cluster needs 6 points.
 FilterParams filters() { return FilterParams{}; }
 
+// `gap` for both gap rules (fragments with fragments, and a group to its nearest bigger cluster).
 ClusterJoinParams params(double float_h, double gap, bool stacked, double margin = 0.0) {
   ClusterJoinParams p;
   p.float_height_m = float_h;
+  p.fragment_gap_m = gap;
   p.gap_m = gap;
   p.stacked = stacked;
   p.stack_margin_m = margin;
@@ -62,6 +64,40 @@ TEST(ClusterJoiner, FloatingFragmentsWithinTheGapJoin) {
   ClusterJoiner j(params(0.8, 0.6, false));
   EXPECT_EQ(j.join(c, h, filters(), k), 3U);
   EXPECT_EQ(sets_of(k), (Sets{{0, 1, 2, 3}, {4}}));
+}
+
+// Fragments join each other over their own gap, wider than the gap over which a group joins a bigger cluster.
+TEST(ClusterJoiner, FragmentsJoinOverTheirOwnGapAndAttachOverTheOther) {
+  // A crown of 27 points (x 10..11), then three floating single returns, 0.8 m apart from each other, the first
+  // 0.75 m beyond the crown's box: with a fragment gap of 1.0 m the three are one group; with a gap of 0.6 m for
+  // the group to a bigger cluster it stays off the crown (and joins it at 0.8 m).
+  Cloud c;
+  testing::add_block(c, {10.F, 0.F, 1.F}, {3, 3, 3}, 0.5F);  // 0..26
+  c.push_back(11.75F, 0.2F, 1.5F);                           // 27
+  c.push_back(12.55F, 0.0F, 2.0F);                           // 28
+  c.push_back(13.35F, 0.1F, 1.8F);                           // 29
+  const auto h = heights_of(c);
+  ClusterJoinParams p = params(0.8, 0.6, false);
+  p.fragment_gap_m = 1.0;
+  Clusters k = clusters_of({range(0, 27), {27}, {28}, {29}});
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 2U);
+  EXPECT_EQ(sets_of(k), (Sets{range(0, 27), {27, 28, 29}}));
+  p.gap_m = 0.8;
+  k = clusters_of({range(0, 27), {27}, {28}, {29}});
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 3U);
+  EXPECT_EQ(sets_of(k), (Sets{range(0, 30)}));
+  // Either gap rule alone: the fragment gap 0 leaves the three apart, and none is within 0.6 m of the crown.
+  p = params(0.8, 0.6, false);
+  p.fragment_gap_m = 0.0;
+  const Sets before{range(0, 27), {27}, {28}, {29}};
+  k = clusters_of(before);
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 0U);
+  EXPECT_EQ(sets_of(k), before);
+  p.fragment_gap_m = 1.0;
+  p.gap_m = 0.0;
+  k = clusters_of(before);
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 2U);
+  EXPECT_EQ(sets_of(k), (Sets{range(0, 27), {27, 28, 29}}));
 }
 
 TEST(ClusterJoiner, FragmentsThatDoNotFloatStayApart) {
@@ -228,13 +264,16 @@ Sets reference_join(const Cloud& c, const std::vector<float>& h, const FilterPar
   const auto gap = [&](std::size_t a, std::size_t b) {
     return std::hypot(std::max(axis_gap(a, b, 0), 0.F), std::max(axis_gap(a, b, 1), 0.F));
   };
-  const auto g = static_cast<float>(p.gap_m);
-  if (p.gap_m > 0.0) {
+  const auto fg = static_cast<float>(p.fragment_gap_m);
+  if (p.fragment_gap_m > 0.0) {
     for (std::size_t a = 0; a < nc; ++a) {
       for (std::size_t b = a + 1; b < nc; ++b) {
-        if (box[a].small && box[b].small && (box[a].floats || box[b].floats) && gap(a, b) <= g) unite(a, b);
+        if (box[a].small && box[b].small && (box[a].floats || box[b].floats) && gap(a, b) <= fg) unite(a, b);
       }
     }
+  }
+  const auto g = static_cast<float>(p.gap_m);
+  if (p.gap_m > 0.0) {
     std::map<std::size_t, std::pair<float, std::size_t>> nearest;  // group root: (gap, big cluster)
     std::map<std::size_t, bool> floats;
     for (std::size_t a = 0; a < nc; ++a) {
@@ -301,7 +340,9 @@ TEST(ClusterJoiner, SweepAgreesWithEveryPairCompared) {
       in.push_back(members);
     }
     std::shuffle(in.begin(), in.end(), rng);  // clusters in no particular order
-    const ClusterJoinParams p = params(0.8, run % 3 == 0 ? 0.0 : 0.6, run % 2 == 0, 0.4);
+    ClusterJoinParams p = params(0.8, run % 3 == 0 ? 0.0 : 0.6, run % 2 == 0, 0.4);
+    if (run % 4 == 1) p.fragment_gap_m = 1.0;  // the two gap rules apart, as fieldguard.yaml has them
+    if (run % 4 == 2) p.fragment_gap_m = 0.0;
     const Sets want = reference_join(c, h, filters(), p, in);
     Clusters k = clusters_of(in);
     ClusterJoiner j(p);
@@ -332,6 +373,11 @@ TEST(ClusterJoiner, SweepAgreesWithEveryPairCompared) {
 TEST(ClusterJoiner, BadInputThrows) {
   EXPECT_THROW(ClusterJoiner(params(-0.1, 0.6, false)), std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(0.8, -1.0, false)), std::invalid_argument);
+  ClusterJoinParams bad_fragment_gap = params(0.8, 0.6, false);
+  bad_fragment_gap.fragment_gap_m = -0.5;
+  EXPECT_THROW(ClusterJoiner{bad_fragment_gap}, std::invalid_argument);
+  bad_fragment_gap.fragment_gap_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(ClusterJoiner{bad_fragment_gap}, std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(0.8, 0.6, true, -0.1)), std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(std::numeric_limits<double>::quiet_NaN(), 0.6, false)), std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(0.8, std::numeric_limits<double>::infinity(), false)), std::invalid_argument);

@@ -10,7 +10,7 @@
 // A cluster "floats" when its lowest point stands at least `float_height_m` above its local ground: crop canopy
 // and terrain never float, and a person's lowest returns are feet or legs. Every rule needs a floating cluster:
 //   1. fragments: two clusters each with fewer points than the filters' minimum at its distance (min_points_at),
-//      one of them floating, whose x-y boxes are at most `gap_m` apart, join (transitively);
+//      one of them floating, whose x-y boxes are at most `fragment_gap_m` apart, join (transitively);
 //   2. each group of fragments holding a floating one joins the one nearest cluster with enough points whose x-y
 //      box is at most `gap_m` from a fragment's (the nearest by that gap; the lower index on a tie). One only: a
 //      fragment between two crowns must not make the two one;
@@ -34,11 +34,12 @@ namespace fieldguard::perception {
 
 struct ClusterJoinParams {
   double float_height_m = 0.0;  // lowest point at least this high above the local ground: floats; 0 = off
-  double gap_m = 0.0;           // rules 1 and 2: horizontal gap between x-y boxes (m); 0 = those rules off
+  double gap_m = 0.0;           // rule 2: horizontal gap between x-y boxes (m); 0 = rule 2 off
   bool stacked = false;         // rule 3 on
   double stack_margin_m = 0.0;  // rule 3: x-y boxes this far apart on each axis still stack (m)
+  double fragment_gap_m = 0.0;  // rule 1: horizontal gap between x-y boxes (m); 0 = rule 1 off
   [[nodiscard]] static ClusterJoinParams from(const ClusterParams& p) {
-    return {p.join_float_height_m, p.join_gap_m, p.join_stacked, p.join_stack_margin_m};
+    return {p.join_float_height_m, p.join_gap_m, p.join_stacked, p.join_stack_margin_m, p.join_fragment_gap_m};
   }
 };
 
