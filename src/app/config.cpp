@@ -239,7 +239,7 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   if (!r.section(c, path,
                  {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m",
                   "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m",
-                  "join_float_height_m", "join_fragment_gap_m", "join_gap_m", "join_stacked", "join_stack_margin_m",
+                  "join_float_height_m", "join_fragment_factor", "join_fragment_gap_m", "join_gap_m", "join_stacked", "join_stack_margin_m",
                   "split_min_length_m", "split_min_part_m", "split_gap_ratio",
                   "split_min_part_points", "split_full_range_m"})) {
     return;
@@ -261,6 +261,7 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   r.integer(c, path, "absorb_max_points", p.absorb_max_points, 0, 1000000);
   r.number(c, path, "absorb_margin_m", p.absorb_margin_m, 0.0, 10.0, "m");
   r.number(c, path, "join_float_height_m", p.join_float_height_m, 0.0, 10.0, "m");
+  r.number(c, path, "join_fragment_factor", p.join_fragment_factor, 1.0, 10.0, "");
   r.number(c, path, "join_fragment_gap_m", p.join_fragment_gap_m, 0.0, 10.0, "m");
   r.number(c, path, "join_gap_m", p.join_gap_m, 0.0, 10.0, "m");
   if (auto j = r.choice(c, path, "join_stacked", {"false", "true"})) p.join_stacked = *j == 1;

@@ -25,6 +25,9 @@ ClusterJoiner::ClusterJoiner(const ClusterJoinParams& params) : params_(params) 
   check_length(params.float_height_m, "float_height_m");
   check_length(params.gap_m, "gap_m");
   check_length(params.fragment_gap_m, "fragment_gap_m");
+  if (!(params.fragment_factor >= 1.0) || !std::isfinite(params.fragment_factor)) {
+    throw std::invalid_argument("ClusterJoiner: fragment_factor must be finite and at least 1");
+  }
   check_length(params.stack_margin_m, "stack_margin_m");
 }
 
@@ -87,7 +90,9 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
     }
     if (!s.empty) {
       s.floats = low >= float_h;
-      s.small = members.size() < min_points_at(filters, std::sqrt(r2));
+      // In double: exact for these counts, and with a factor of 1 the filters' own test.
+      s.small = static_cast<double>(members.size()) <
+                params_.fragment_factor * static_cast<double>(min_points_at(filters, std::sqrt(r2)));
     }
     info_[c] = s;
   }

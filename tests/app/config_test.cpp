@@ -129,6 +129,7 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.cluster.absorb_max_points, d.cluster.absorb_max_points);
   EXPECT_EQ(p.cluster.absorb_margin_m, d.cluster.absorb_margin_m);
   EXPECT_EQ(p.cluster.join_float_height_m, d.cluster.join_float_height_m);
+  EXPECT_EQ(p.cluster.join_fragment_factor, d.cluster.join_fragment_factor);
   EXPECT_EQ(p.cluster.join_fragment_gap_m, d.cluster.join_fragment_gap_m);
   EXPECT_EQ(p.cluster.join_gap_m, d.cluster.join_gap_m);
   EXPECT_EQ(p.cluster.join_stacked, d.cluster.join_stacked);
@@ -507,14 +508,15 @@ TEST(ConfigLoad, ReportsBadAnisotropicClusterKeys) {
 TEST(ConfigLoad, ReadsTheFloatingClusterKeys) {
   const auto r = load_config_text(R"(
 perception:
-  cluster: {join_float_height_m: 0.9, join_fragment_gap_m: 1.3, join_gap_m: 0.7, join_stacked: false,
-            join_stack_margin_m: 0.5}
+  cluster: {join_float_height_m: 0.9, join_fragment_factor: 2.0, join_fragment_gap_m: 1.3, join_gap_m: 0.7,
+            join_stacked: false, join_stack_margin_m: 0.5}
   filters: {float_min_height_m: 1.2, float_min_points: 4}
 )",
                                   "t.yaml");
   ASSERT_TRUE(r.ok()) << dump(r);
   const auto& c = r.config.perception.cluster;
   EXPECT_DOUBLE_EQ(c.join_float_height_m, 0.9);
+  EXPECT_DOUBLE_EQ(c.join_fragment_factor, 2.0);
   EXPECT_DOUBLE_EQ(c.join_fragment_gap_m, 1.3);
   EXPECT_DOUBLE_EQ(c.join_gap_m, 0.7);
   EXPECT_FALSE(c.join_stacked);
@@ -524,6 +526,7 @@ perception:
   const auto d = load_config_text("perception: {}\n", "t.yaml");
   ASSERT_TRUE(d.ok()) << dump(d);
   EXPECT_EQ(d.config.perception.cluster.join_float_height_m, 0.8);
+  EXPECT_EQ(d.config.perception.cluster.join_fragment_factor, 1.5);
   EXPECT_EQ(d.config.perception.cluster.join_fragment_gap_m, 1.0);
   EXPECT_EQ(d.config.perception.cluster.join_gap_m, 0.6);
   EXPECT_TRUE(d.config.perception.cluster.join_stacked);
@@ -541,18 +544,20 @@ TEST(ConfigLoad, ReportsBadFloatingClusterKeys) {
       "    join_stacked: yes please\n"      // 5 not true or false
       "    join_stack_margin_m: -1\n"       // 6 out of range
       "    join_fragment_gap_m: -1\n"       // 7 out of range
-      "  filters:\n"                        // 8
-      "    float_min_height_m: 11\n"        // 9 out of range
-      "    float_min_points: 0\n";          // 10 out of range
+      "    join_fragment_factor: 0.5\n"     // 8 out of range
+      "  filters:\n"                        // 9
+      "    float_min_height_m: 11\n"        // 10 out of range
+      "    float_min_points: 0\n";          // 11 out of range
   const auto r = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_float_height_m", "out of range", 3)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_gap_m", "out of range", 4)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_stacked", "is not one of", 5)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_stack_margin_m", "out of range", 6)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_fragment_gap_m", "out of range", 7)) << dump(r);
-  EXPECT_TRUE(has_issue(r, "perception.filters.float_min_height_m", "out of range", 9)) << dump(r);
-  EXPECT_TRUE(has_issue(r, "perception.filters.float_min_points", "out of range", 10)) << dump(r);
-  EXPECT_EQ(r.issues.size(), 7U) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.cluster.join_fragment_factor", "out of range", 8)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.filters.float_min_height_m", "out of range", 10)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.filters.float_min_points", "out of range", 11)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 8U) << dump(r);
 }
 
 // The least height's growth with distance (cluster_filter.hpp): read; left out, fieldguard.yaml's values.

@@ -18,8 +18,8 @@ namespace fieldguard::perception {
 namespace {
 
 using testing::clusters_of;
-using testing::Sets;
 using testing::same_bounds;
+using testing::Sets;
 using testing::sets_of;
 
 std::vector<std::uint32_t> range(std::uint32_t from, std::uint32_t to) {
@@ -98,6 +98,33 @@ TEST(ClusterJoiner, FragmentsJoinOverTheirOwnGapAndAttachOverTheOther) {
   k = clusters_of(before);
   EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 2U);
   EXPECT_EQ(sets_of(k), (Sets{range(0, 27), {27, 28, 29}}));
+}
+
+// A crown seen through gaps as two small obstacles (each passing the filters alone): its foliage and its trunk's
+// returns. With a fragment factor above 1 they are fragments, and join; with 1 they stay two.
+TEST(ClusterJoiner, TheFragmentFactorMakesSmallObstaclesFragments) {
+  // At 10 m the filters want 6 points: 8 foliage returns 1.5-2.2 m up and 7 trunk returns 0.1-0.7 m up, their x-y
+  // boxes 0.9 m apart.
+  Cloud c;
+  for (int i = 0; i < 8; ++i)
+    c.push_back(10.F + 0.05F * static_cast<float>(i), 0.F, 1.5F + 0.1F * static_cast<float>(i));
+  for (int i = 0; i < 7; ++i)
+    c.push_back(11.F + 0.05F * static_cast<float>(i), 0.6F, 0.1F + 0.1F * static_cast<float>(i));
+  const auto h = heights_of(c);
+  const Sets before{range(0, 8), range(8, 15)};
+  ClusterJoinParams p = params(0.8, 0.6, false);
+  p.fragment_gap_m = 1.0;
+  Clusters k = clusters_of(before);
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 0U);  // factor 1: two obstacles
+  EXPECT_EQ(sets_of(k), before);
+  p.fragment_factor = 1.5;  // fewer than 9 points: both are fragments
+  k = clusters_of(before);
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 1U);
+  EXPECT_EQ(sets_of(k), (Sets{range(0, 15)}));
+  p.fragment_factor = 1.2;  // fewer than 7.2: only the trunk, which does not float, and is 0.9 m off the foliage
+  k = clusters_of(before);
+  EXPECT_EQ(ClusterJoiner(p).join(c, h, filters(), k), 0U);
+  EXPECT_EQ(sets_of(k), before);
 }
 
 TEST(ClusterJoiner, FragmentsThatDoNotFloatStayApart) {
@@ -244,7 +271,8 @@ Sets reference_join(const Cloud& c, const std::vector<float>& h, const FilterPar
       r2 = std::min(r2, c.x[i] * c.x[i] + c.y[i] * c.y[i]);
     }
     b.floats = !b.empty && low >= static_cast<float>(p.float_height_m);
-    b.small = !b.empty && in[k].size() < min_points_at(f, std::sqrt(r2));
+    b.small = !b.empty && static_cast<double>(in[k].size()) <
+                              p.fragment_factor * static_cast<double>(min_points_at(f, std::sqrt(r2)));
     box[k] = b;
   }
   std::vector<std::size_t> up(nc);
@@ -343,6 +371,7 @@ TEST(ClusterJoiner, SweepAgreesWithEveryPairCompared) {
     ClusterJoinParams p = params(0.8, run % 3 == 0 ? 0.0 : 0.6, run % 2 == 0, 0.4);
     if (run % 4 == 1) p.fragment_gap_m = 1.0;  // the two gap rules apart, as fieldguard.yaml has them
     if (run % 4 == 2) p.fragment_gap_m = 0.0;
+    if (run % 3 == 1) p.fragment_factor = 1.5;
     const Sets want = reference_join(c, h, filters(), p, in);
     Clusters k = clusters_of(in);
     ClusterJoiner j(p);
@@ -378,6 +407,11 @@ TEST(ClusterJoiner, BadInputThrows) {
   EXPECT_THROW(ClusterJoiner{bad_fragment_gap}, std::invalid_argument);
   bad_fragment_gap.fragment_gap_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(ClusterJoiner{bad_fragment_gap}, std::invalid_argument);
+  ClusterJoinParams bad_factor = params(0.8, 0.6, false);
+  bad_factor.fragment_factor = 0.9;  // a cluster the filters drop would be no fragment
+  EXPECT_THROW(ClusterJoiner{bad_factor}, std::invalid_argument);
+  bad_factor.fragment_factor = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(ClusterJoiner{bad_factor}, std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(0.8, 0.6, true, -0.1)), std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(std::numeric_limits<double>::quiet_NaN(), 0.6, false)), std::invalid_argument);
   EXPECT_THROW(ClusterJoiner(params(0.8, std::numeric_limits<double>::infinity(), false)), std::invalid_argument);

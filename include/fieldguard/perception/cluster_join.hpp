@@ -9,8 +9,9 @@
 //
 // A cluster "floats" when its lowest point stands at least `float_height_m` above its local ground: crop canopy
 // and terrain never float, and a person's lowest returns are feet or legs. Every rule needs a floating cluster:
-//   1. fragments: two clusters each with fewer points than the filters' minimum at its distance (min_points_at),
-//      one of them floating, whose x-y boxes are at most `fragment_gap_m` apart, join (transitively);
+//   1. fragments: two clusters each with fewer points than `fragment_factor` times the filters' minimum at its
+//      distance (min_points_at), one of them floating, whose x-y boxes are at most `fragment_gap_m` apart, join
+//      (transitively);
 //   2. each group of fragments holding a floating one joins the one nearest cluster with enough points whose x-y
 //      box is at most `gap_m` from a fragment's (the nearest by that gap; the lower index on a tie). One only: a
 //      fragment between two crowns must not make the two one;
@@ -38,8 +39,12 @@ struct ClusterJoinParams {
   bool stacked = false;         // rule 3 on
   double stack_margin_m = 0.0;  // rule 3: x-y boxes this far apart on each axis still stack (m)
   double fragment_gap_m = 0.0;  // rule 1: horizontal gap between x-y boxes (m); 0 = rule 1 off
+  // Rules 1 and 2: a fragment has fewer points than this times min_points_at (at least 1: every cluster the filters
+  // drop is a fragment).
+  double fragment_factor = 1.0;
   [[nodiscard]] static ClusterJoinParams from(const ClusterParams& p) {
-    return {p.join_float_height_m, p.join_gap_m, p.join_stacked, p.join_stack_margin_m, p.join_fragment_gap_m};
+    return {p.join_float_height_m, p.join_gap_m,          p.join_stacked,
+            p.join_stack_margin_m, p.join_fragment_gap_m, p.join_fragment_factor};
   }
 };
 
@@ -77,8 +82,8 @@ class ClusterJoiner {
   Buffer<float> attach_gap_;
   Buffer<std::uint8_t> group_floats_;
   Buffer<std::uint32_t> order_;  // the sweep's clusters, by their low x edge
-  Buffer<std::uint32_t> big_;    // clusters with enough points for the filters
-  Buffer<std::uint32_t> root_;  // per cluster: its union-find root, the cluster it ends in
+  Buffer<std::uint32_t> big_;    // clusters that are no fragments
+  Buffer<std::uint32_t> root_;   // per cluster: its union-find root, the cluster it ends in
   Buffer<std::uint32_t> of_point_;
   Buffer<std::uint32_t> id_;
   Buffer<std::uint32_t> count_;

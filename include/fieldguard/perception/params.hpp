@@ -113,10 +113,12 @@ struct ClusterParams {
   int absorb_max_points = 10;
   double absorb_margin_m = 0.3;
   // Then (cluster_join.hpp): a cluster whose lowest point is at least join_float_height_m above its ground
-  // floats; floating fragments too small for the filters join each other within join_fragment_gap_m and then their
-  // one nearest bigger cluster within join_gap_m (x-y boxes); with join_stacked a floating cluster joins every
-  // cluster whose x-y box is within join_stack_margin_m of its own on each axis. join_float_height_m 0 = off.
+  // floats; floating fragments (fewer points than join_fragment_factor times the filters' minimum) join each other
+  // within join_fragment_gap_m and then their one nearest bigger cluster within join_gap_m (x-y boxes); with
+  // join_stacked a floating cluster joins every cluster whose x-y box is within join_stack_margin_m of its own on
+  // each axis. join_float_height_m 0 = off.
   double join_float_height_m = 0.8;
+  double join_fragment_factor = 1.5;
   double join_fragment_gap_m = 1.0;
   double join_gap_m = 0.6;
   bool join_stacked = true;
