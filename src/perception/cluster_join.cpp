@@ -120,9 +120,9 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
   };
 
   if (fragments) {
-    // 1. Fragments with fragments: over a wider gap than rule 2's (fieldguard.yaml: 1.0 against 0.6 m). A group of
-    // fragments is a handful of returns, no obstacle alone; widening rule 2's gap instead bridges neighbouring
-    // crowns through the fragments between them.
+    // 1. Fragments with fragments: over a wider gap than rule 2's (fieldguard.yaml: 1.0 against 0.6 m). Fragments
+    // are a few returns each, of one porous crown seen through gaps; widening rule 2's gap instead bridges
+    // neighbouring crowns through the fragments between them.
     const auto gap = static_cast<float>(params_.fragment_gap_m);
     sweep([&](std::size_t c) { return !info_[c].empty && info_[c].small; }, gap,
           [&](std::uint32_t a, std::uint32_t b) {
@@ -132,7 +132,7 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
   }
   if (attach) {
     const auto gap = static_cast<float>(params_.gap_m);
-    // 2. Each group with a floating fragment: to its one nearest cluster with enough points. Every group's choice is
+    // 2. Each group with a floating fragment: to its one nearest cluster that is no fragment. Every group's choice is
     // made before any is applied, on the groups of step 1.
     attach_.assign(nc, kNone);
     attach_gap_.assign(nc, kBig);

@@ -12,7 +12,7 @@
 //   1. fragments: two clusters each with fewer points than `fragment_factor` times the filters' minimum at its
 //      distance (min_points_at), one of them floating, whose x-y boxes are at most `fragment_gap_m` apart, join
 //      (transitively);
-//   2. each group of fragments holding a floating one joins the one nearest cluster with enough points whose x-y
+//   2. each group of fragments holding a floating one joins the one nearest cluster that is no fragment whose x-y
 //      box is at most `gap_m` from a fragment's (the nearest by that gap; the lower index on a tie). One only: a
 //      fragment between two crowns must not make the two one;
 //   3. stacked (`stacked`): a floating cluster joins every cluster whose x-y box is no farther than
