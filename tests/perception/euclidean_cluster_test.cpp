@@ -385,16 +385,19 @@ TEST(EuclideanClusterer, GridTailsAndShortRunsMatchTheKdTree) {
   }
 }
 
+// The grid structure's cell edge for radius `t` over a cloud of this extent (euclidean_cluster.cpp: the radius less
+// the rounding allowance, over sqrt 3), as the tests that build cell-edge cases compute it.
+float grid_edge(float t, float extent) {
+  const float rounding = 8.F * extent * std::numeric_limits<float>::epsilon() + 1e-3F;
+  return (t * 0.999F - 2.F * rounding) / std::numbers::sqrt3_v<float>;
+}
+
 // A point on the cloud's upper bound whose cell, computed in float, rounds up to one past the grid's last (the
 // grid's cell count comes from the same span in double): it must land in the last cell, on x and on z, four at a
 // time (the first four points) as one by one. The spans that do this are searched for here with the grid's cell
 // edge for a 0.6 m radius (euclidean_cluster.cpp: the radius less the rounding allowance, over sqrt 3); should
 // that formula change, the search finds none and the test says so.
 TEST(EuclideanClusterer, GridPointOnTheUpperBoundStaysInTheLastCell) {
-  const auto edge_for = [](float t, float extent) {
-    const float rounding = 8.F * extent * std::numeric_limits<float>::epsilon() + 1e-3F;
-    return (t * 0.999F - 2.F * rounding) / std::numbers::sqrt3_v<float>;
-  };
   // Whether a span's float cell index is the count of cells the double division gives (one past the last).
   const auto past_the_last = [](float span, float edge) {
     const auto cells = static_cast<std::size_t>(static_cast<double>(span) / static_cast<double>(edge)) + 1;
@@ -404,11 +407,11 @@ TEST(EuclideanClusterer, GridPointOnTheUpperBoundStaysInTheLastCell) {
   // [k0, k1): the first that is one past the last, or 0.
   const auto find_span = [&](float t, int k0, int k1, bool sets_extent, float extent) {
     for (int k = k0; k < k1; ++k) {
-      const float guess = edge_for(t, sets_extent ? static_cast<float>(k) * t / 1.7F : extent);
+      const float guess = grid_edge(t, sets_extent ? static_cast<float>(k) * t / 1.7F : extent);
       auto span = static_cast<float>(k * static_cast<double>(guess));
       for (int step = 0; step < 32; ++step) span = std::nextafter(span, 1e9F);
       for (int step = 0; step < 64; ++step, span = std::nextafter(span, 0.F)) {
-        if (past_the_last(span, edge_for(t, sets_extent ? span : extent))) return span;
+        if (past_the_last(span, grid_edge(t, sets_extent ? span : extent))) return span;
       }
     }
     return 0.F;
@@ -476,8 +479,7 @@ TEST(EuclideanClusterer, GridColumnLookReachesTheStencilsLowestCell) {
     ClusterParams grid = kd;
     grid.structure = ClusterStructure::Grid;
     // The grid's cell edge (the extent is 20: the lone point's x) and a cell's stencil depth in z cells at the cap.
-    const float rounding = 8.F * 20.F * std::numeric_limits<float>::epsilon() + 1e-3F;
-    const float edge = (t * 0.999F - 2.F * rounding) / std::numbers::sqrt3_v<float>;
+    const float edge = grid_edge(t, 20.F);
     const float inv = 1.F / edge;
     const auto reach = static_cast<std::int32_t>((cap + 1e-3F) * inv) + 1;
     const auto cell = [inv](float v, float origin) { return static_cast<std::int32_t>((v - origin) * inv); };
