@@ -239,7 +239,8 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   if (!r.section(c, path,
                  {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m",
                   "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m",
-                  "join_float_height_m", "join_fragment_factor", "join_fragment_gap_m", "join_gap_m", "join_stacked", "join_stack_margin_m",
+                  "join_float_height_m", "join_fragment_factor", "join_fragment_gap_m", "join_gap_m", "join_stacked",
+                  "join_stack_margin_m",
                   "split_min_length_m", "split_min_part_m", "split_gap_ratio",
                   "split_min_part_points", "split_full_range_m"})) {
     return;
