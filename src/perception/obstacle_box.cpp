@@ -34,6 +34,14 @@ inline void load4(std::span<const P2> all, std::size_t i, simd::f32x4& px, simd:
 
 std::string_view to_string(SizeClass c) { return c == SizeClass::Small ? "small" : "large"; }
 
+void sort_obstacles(std::vector<Obstacle>& obstacles) {
+  std::sort(obstacles.begin(), obstacles.end(), [](const Obstacle& a, const Obstacle& b) {
+    if (a.distance_m != b.distance_m) return a.distance_m < b.distance_m;
+    if (a.bearing_deg != b.bearing_deg) return a.bearing_deg < b.bearing_deg;
+    return a.min < b.min;
+  });
+}
+
 namespace {
 
 // A float's bits as an unsigned integer in the same order (negatives flipped): (x, y) then sorts as one

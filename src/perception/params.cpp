@@ -27,6 +27,8 @@ PipelineParams published_params() {
   p.filters.canopy_max_height_m = 0.0;
   // The published method had no 2D LiDAR: 2D points of a merged frame are left out of it entirely.
   p.near_field.enabled = false;
+  // Nor did it hold anything from one rotation to the next.
+  p.hold.enabled = false;
   return p;
 }
 

@@ -76,6 +76,13 @@ float lap_us(std::chrono::steady_clock::time_point& from) {
   return us;
 }
 
+// A cluster the filters found TooFewPoints (check_cluster's first test) is ObstacleHold's evidence when it stands
+// as high above its measured ground as an obstacle must (fragments, obstacle.hpp).
+void add_fragment(const FilterParams& f, const ClusterSummary& s, std::vector<Fragment>& out) {
+  if (s.ground_guessed || static_cast<double>(s.height_above_ground_m) < min_height_at(f, s.distance_m)) return;
+  out.push_back(Fragment{s.min, s.max, s.points, s.distance_m, s.height_above_ground_m});
+}
+
 }  // namespace
 
 struct Pipeline::Impl {
@@ -269,12 +276,19 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   if (f.canopy_surroundings_m > 0.0 && m.surround_marks.size() != n) m.surround_marks.assign(n, 0U);
   const FrameSurroundings around{m.voxels, m.ground.height_m, m.above_index, m.surround_marks};
   const std::uint32_t least_points = least_min_points(f);
+  const bool fragments = m.params.hold.enabled;
   for (std::size_t c = 0; c < m.clusters.size(); ++c) {
     const auto members = m.clusters[c];
     // Most clusters are a return or two, too few for any distance: TooFewPoints below whatever their summary.
-    if (members.size() < least_points) continue;
+    if (members.size() < least_points) {
+      if (fragments) {
+        add_fragment(f, summary_of(m.bounds[c], static_cast<std::uint32_t>(members.size())), result.fragments);
+      }
+      continue;
+    }
     ClusterSummary s = summary_of(m.bounds[c], static_cast<std::uint32_t>(members.size()));
     Rejection why = check_cluster(f, s);
+    if (fragments && why == Rejection::TooFewPoints) add_fragment(f, s, result.fragments);
     if (s.ground_guessed && why == Rejection::Kept) {
       // No ground measured under it: its height is what it shows, from the lowest point under its footprint
       // (ground-labelled points under it may be its own feet) to its top. (Only a kept cluster can change:
@@ -320,6 +334,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
     result.obstacles.push_back(o);
   }
   result.counts.obstacles = static_cast<std::uint32_t>(result.obstacles.size());
+  result.counts.fragments = static_cast<std::uint32_t>(result.fragments.size());
   result.times.boxes_us = lap_us(lap);
 
   result.counts.near_input = static_cast<std::uint32_t>(m.points2d.size());
@@ -333,11 +348,7 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
         m.near.fuse(result.obstacles, result.counts.obstacles, static_cast<float>(m.params.cluster.tolerance_m));
   }
 
-  std::sort(result.obstacles.begin(), result.obstacles.end(), [](const Obstacle& a, const Obstacle& b) {
-    if (a.distance_m != b.distance_m) return a.distance_m < b.distance_m;
-    if (a.bearing_deg != b.bearing_deg) return a.bearing_deg < b.bearing_deg;
-    return a.min < b.min;
-  });
+  sort_obstacles(result.obstacles);
   result.times.near_us = lap_us(lap);
   result.times.total_us = std::chrono::duration<float, std::micro>(lap - start).count();
   return result;

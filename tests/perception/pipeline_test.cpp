@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstring>
 #include <limits>
@@ -271,6 +272,49 @@ TEST(Pipeline, GroundBeyondTheRegionOfInterestIsContextOnly) {
                                       << " m high";
   EXPECT_EQ(seen.counts.after_roi, in_roi);
   EXPECT_GT(seen.counts.after_voxel, cut.counts.after_voxel) << "the context went into the ground stage";
+}
+
+// Groups too few for the filters are the hold's evidence (obstacle_hold.hpp) when they stand as high as an
+// obstacle must: two returns 1.5 m up at 10 m (a crown's, seen through a gap; a floating group needs three) and
+// a lone return 1.2 m up at 12 m are fragments; two returns 0.2 m up (a clod's top) and a full obstacle are not.
+// Without the hold (the published method) no fragment is gathered.
+TEST(Pipeline, FragmentsAreTheRaisedGroupsTooFewForTheFilters) {
+  constexpr float kFloor = -0.95F;
+  Cloud c;
+  testing::add_plane(c, 0.F, 0.F, kFloor, 2.F, 30.F, -6.F, 6.F, 0.2F);
+  c.push_back(10.F, 3.1F, kFloor + 1.5F);  // the crown's two
+  c.push_back(10.F, 3.4F, kFloor + 1.6F);
+  c.push_back(12.F, -3.1F, kFloor + 1.2F);  // the lone return
+  c.push_back(8.F, -1.1F, kFloor + 0.2F);   // the clod's top
+  c.push_back(8.F, -1.4F, kFloor + 0.2F);
+  testing::add_block(c, {6.F, 1.F, kFloor + 0.1F}, {4, 4, 12}, 0.1F);  // a 1.2 m post: an obstacle
+  const std::vector<LidarPoint> pts = testing::to_lidar(c);
+
+  const FrameResult r = Pipeline(PipelineParams{}).process(pts);
+  ASSERT_EQ(r.obstacles.size(), 1U);
+  EXPECT_NEAR(r.obstacles[0].distance_m, std::hypot(6.F, 1.F), 0.1F);
+  ASSERT_EQ(r.fragments.size(), 2U);
+  EXPECT_EQ(r.counts.fragments, 2U);
+  std::vector<Fragment> f = r.fragments;
+  std::sort(f.begin(), f.end(), [](const Fragment& a, const Fragment& b) { return a.min[0] < b.min[0]; });
+  EXPECT_EQ(f[0].points, 2U);
+  EXPECT_FLOAT_EQ(f[0].min[1], 3.1F);
+  EXPECT_FLOAT_EQ(f[0].max[1], 3.4F);
+  EXPECT_FLOAT_EQ(f[0].max[2], kFloor + 1.6F);
+  EXPECT_NEAR(f[0].height_above_ground_m, 1.6F, 0.02F);
+  EXPECT_NEAR(f[0].distance_m, std::hypot(10.F, 3.1F), 0.01F);
+  EXPECT_EQ(f[1].points, 1U);
+  EXPECT_FLOAT_EQ(f[1].min[0], 12.F);
+  EXPECT_NEAR(f[1].height_above_ground_m, 1.2F, 0.02F);
+
+  PipelineParams off;
+  off.hold.enabled = false;
+  const FrameResult without = Pipeline(off).process(pts);
+  EXPECT_TRUE(without.fragments.empty());
+  EXPECT_EQ(without.counts.fragments, 0U);
+  ASSERT_EQ(without.obstacles.size(), 1U);
+  EXPECT_TRUE(same_bits(without.obstacles[0], r.obstacles[0]));
+  EXPECT_TRUE(Pipeline(published_params()).process(pts).fragments.empty());
 }
 
 TEST(Pipeline, LargeObjectsAreLarge) {

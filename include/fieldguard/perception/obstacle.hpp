@@ -32,6 +32,19 @@ struct Obstacle {
   float height_above_ground_m = 0.F;  // highest point above the local ground under the cluster
   SizeClass size_class = SizeClass::Small;
   std::uint8_t sources = kSeenBy3d;   // kSeenBy3d | kSeenBy2d: which sensors' points it holds
+  // Reported by ObstacleHold (obstacle_hold.hpp) from this frame's fragments where an obstacle was reported
+  // lately, not by the filters: its boxes are the fragments' (axis-aligned; the oriented box is the same).
+  bool held = false;
+};
+
+// A group of returns the filters found too few for its distance, but standing high enough above its ground to
+// count (min_height_at); its ground measured, not guessed. Not an obstacle on its own: ObstacleHold's evidence.
+struct Fragment {
+  std::array<float, 3> min{};  // axis-aligned box (m)
+  std::array<float, 3> max{};
+  std::uint32_t points = 0;
+  float distance_m = 0.F;             // as Obstacle's
+  float height_above_ground_m = 0.F;  // its highest point's
 };
 
 // Points of the processed frame with what the pipeline made of them, for pictures and debugging.
@@ -52,11 +65,14 @@ struct StageCounts {
   std::uint32_t clusters = 0;     // before the filters
   std::uint32_t obstacles = 0;    // after the filters
   // The 2D LiDAR's near-field path (near_field.hpp); none of its points is counted above. Obstacles
-  // reported = obstacles + near_obstacles - near_merged.
+  // reported = obstacles + near_obstacles - near_merged + held.
   std::uint32_t near_input = 0;      // 2D LiDAR points in the frame
   std::uint32_t near_in_zone = 0;    // of them, finite and inside the near zone
   std::uint32_t near_obstacles = 0;  // segments kept as obstacles
   std::uint32_t near_merged = 0;     // of them, merged into a 3D obstacle they overlap
+  // ObstacleHold's, after process() (obstacle_hold.hpp): obstacles reported from fragments.
+  std::uint32_t held = 0;
+  std::uint32_t fragments = 0;  // fragments of the frame (FrameResult::fragments)
 };
 
 // How long each stage took on this frame (steady clock, microseconds), measured inside process(): in the
@@ -75,8 +91,12 @@ struct StageTimes {
   float total_us = 0.F;     // all of process()
 };
 
+// Sorts by distance_m, nearest first; ties by bearing_deg, then by the box's min corner (deterministic).
+void sort_obstacles(std::vector<Obstacle>& obstacles);
+
 struct FrameResult {
-  std::vector<Obstacle> obstacles;  // sorted by distance_m, nearest first; ties by bearing
+  std::vector<Obstacle> obstacles;  // sorted by distance_m, nearest first; ties by bearing (sort_obstacles)
+  std::vector<Fragment> fragments;  // when HoldParams::enabled; in cluster order
   StageCounts counts;
   StageTimes times;
 };

@@ -197,6 +197,25 @@ struct NearFieldParams {
   double min_height_m = 0.15;
 };
 
+// Holding a recent obstacle's place (obstacle_hold.hpp): where an obstacle was reported by the filters within the
+// last max_age_s and nothing is reported this frame, the frame's fragments there (groups of raised returns too
+// few for the filters, fragments below) are reported together as the obstacle, when they hold min_points
+// points. A tree crown seen through the gaps of a nearer row shows three to five returns more than a metre
+// apart in one rotation and a full cluster in the next; a person behind a post likewise. Nothing is held
+// without returns of this frame, and a held obstacle holds nothing itself: an obstacle last seen by the filters
+// more than max_age_s ago is let go.
+struct HoldParams {
+  bool enabled = true;
+  // From the last full detection. 0.35 s: three rotations at 10 Hz, one at 5 Hz (with its jitter).
+  double max_age_s = 0.35;
+  // Fragments count when their box comes this near the held box (m). The held box is where the obstacle was
+  // in the sensor frame: the tractor's travel over max_age_s must fit in it (0.3 m: 0.85 m/s at 0.35 s, the
+  // orchard's crawl; raise it for faster work).
+  double gate_m = 0.3;
+  // Points the fragments within the gate must hold together: the filters' own least far out (min_points_floor).
+  int min_points = 2;
+};
+
 struct PipelineParams {
   VoxelParams voxel;
   Box3 roi{{-10.0, -10.0, -6.0}, {52.0, 10.0, 6.0}};
@@ -205,6 +224,7 @@ struct PipelineParams {
   ClusterParams cluster;
   FilterParams filters;
   NearFieldParams near_field;
+  HoldParams hold;
 };
 
 // The published pipeline's parameters (config/published.yaml): for tests and benchmarks.

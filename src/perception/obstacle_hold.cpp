@@ -1,0 +1,142 @@
+#include "fieldguard/perception/obstacle_hold.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "fieldguard/perception/obstacle_box.hpp"
+
+namespace fieldguard::perception {
+
+namespace {
+
+// Boxes [amin, amax] grown by `g` on every side and [bmin, bmax] share a point (closed boxes).
+bool touch(const std::array<float, 3>& amin, const std::array<float, 3>& amax, float g,
+           const std::array<float, 3>& bmin, const std::array<float, 3>& bmax) {
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (bmax[i] < amin[i] - g || bmin[i] > amax[i] + g) return false;
+  }
+  return true;
+}
+
+// Boxes that are one obstacle seen twice: overlapping in z, and in x and in y by at least half the shorter of the
+// two extents (0.05 m added to both sides, for boxes of a single return). Neighbouring crowns whose boxes come
+// within the gate of each other, or overlap by a sliver, are not.
+bool same_place(const std::array<float, 3>& amin, const std::array<float, 3>& amax, const std::array<float, 3>& bmin,
+                const std::array<float, 3>& bmax) {
+  constexpr float kSingle = 0.05F;
+  if (bmax[2] < amin[2] || bmin[2] > amax[2]) return false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const float common = std::min(amax[i], bmax[i]) - std::max(amin[i], bmin[i]);
+    const float shorter = std::min(amax[i] - amin[i], bmax[i] - bmin[i]);
+    if (common + kSingle < 0.5F * (shorter + kSingle)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+ObstacleHold::ObstacleHold(const HoldParams& params) : params_(params) {
+  if (!std::isfinite(params.max_age_s) || params.max_age_s < 0.0) {
+    throw std::invalid_argument("ObstacleHold: max_age_s must be finite and not negative");
+  }
+  if (!std::isfinite(params.gate_m) || params.gate_m < 0.0) {
+    throw std::invalid_argument("ObstacleHold: gate_m must be finite and not negative");
+  }
+  if (params.min_points < 1) throw std::invalid_argument("ObstacleHold: min_points must be at least 1");
+  max_age_ns_ = std::llround(params.max_age_s * 1e9);
+}
+
+std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result) {
+  if (!params_.enabled) return 0;
+  if (any_frame_ && stamp_ns < last_ns_) seen_.clear();
+  any_frame_ = true;
+  last_ns_ = stamp_ns;
+  std::erase_if(seen_, [&](const Seen& s) { return stamp_ns - s.stamp_ns > max_age_ns_; });
+
+  const auto gate = static_cast<float>(params_.gate_m);
+  const std::size_t reported = result.obstacles.size();
+  const std::vector<Fragment>& fragments = result.fragments;
+  used_.assign(fragments.size(), 0U);
+  // Fragments in order of their boxes' least x, with the widest box's x extent: those that can touch a box
+  // reaching from x0 to x1 start in [x0 - widest, x1].
+  order_.resize(fragments.size());
+  float widest = 0.F;
+  for (std::size_t i = 0; i < fragments.size(); ++i) {
+    order_[i] = static_cast<std::uint32_t>(i);
+    widest = std::max(widest, fragments[i].max[0] - fragments[i].min[0]);
+  }
+  std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return fragments[a].min[0] != fragments[b].min[0] ? fragments[a].min[0] < fragments[b].min[0] : a < b;
+  });
+
+  next_.clear();
+  std::size_t held = 0;
+  for (const Seen& s : seen_) {
+    bool again = false;
+    for (std::size_t o = 0; o < reported && !again; ++o) {
+      again = same_place(s.min, s.max, result.obstacles[o].min, result.obstacles[o].max);
+    }
+    if (again) continue;  // reported this frame: remembered from this frame's report
+    next_.push_back(s);
+
+    const float x0 = s.min[0] - gate, x1 = s.max[0] + gate;
+    auto it = std::lower_bound(order_.begin(), order_.end(), x0 - widest,
+                               [&](std::uint32_t f, float x) { return fragments[f].min[0] < x; });
+    picked_.clear();
+    std::uint32_t points = 0;
+    for (; it != order_.end() && fragments[*it].min[0] <= x1; ++it) {
+      const std::uint32_t f = *it;
+      const Fragment& fr = fragments[f];
+      if (used_[f] != 0U || !touch(s.min, s.max, gate, fr.min, fr.max)) continue;
+      // Inside an obstacle of this frame's (a part the filters have already reported): not this one's.
+      bool inside = false;
+      for (std::size_t o = 0; o < reported && !inside; ++o) {
+        inside = touch(result.obstacles[o].min, result.obstacles[o].max, 0.F, fr.min, fr.max);
+      }
+      if (inside) continue;
+      picked_.push_back(f);
+      points += fr.points;
+    }
+    if (points < static_cast<std::uint32_t>(params_.min_points)) continue;
+
+    Obstacle h;
+    h.min = fragments[picked_.front()].min;
+    h.max = fragments[picked_.front()].max;
+    h.distance_m = fragments[picked_.front()].distance_m;
+    for (const std::uint32_t f : picked_) {
+      const Fragment& fr = fragments[f];
+      used_[f] = 1U;
+      for (std::size_t i = 0; i < 3; ++i) {
+        h.min[i] = std::min(h.min[i], fr.min[i]);
+        h.max[i] = std::max(h.max[i], fr.max[i]);
+      }
+      h.distance_m = std::min(h.distance_m, fr.distance_m);
+      h.height_above_ground_m = std::max(h.height_above_ground_m, fr.height_above_ground_m);
+    }
+    h.points = points;
+    const float cx = 0.5F * (h.min[0] + h.max[0]), cy = 0.5F * (h.min[1] + h.max[1]);
+    h.bearing_deg =
+        static_cast<float>(std::atan2(static_cast<double>(cy), static_cast<double>(cx)) * 180.0 / std::numbers::pi);
+    const float dx = h.max[0] - h.min[0], dy = h.max[1] - h.min[1];
+    h.obb_center = {cx, cy};
+    h.obb_length_m = std::max(dx, dy);
+    h.obb_width_m = std::min(dx, dy);
+    h.obb_yaw_rad = dx >= dy ? 0.F : static_cast<float>(std::numbers::pi / 2);
+    h.size_class = size_class(h.obb_length_m, h.obb_width_m, h.max[2] - h.min[2]);
+    h.sources = kSeenBy3d;
+    h.held = true;
+    result.obstacles.push_back(h);
+    ++held;
+  }
+  for (std::size_t o = 0; o < reported; ++o) {
+    next_.push_back(Seen{result.obstacles[o].min, result.obstacles[o].max, stamp_ns});
+  }
+  seen_.swap(next_);
+  if (held > 0) sort_obstacles(result.obstacles);
+  result.counts.held = static_cast<std::uint32_t>(held);
+  return held;
+}
+
+}  // namespace fieldguard::perception
