@@ -347,9 +347,18 @@ void read_near_field(YamlReader& r, const YAML::Node& n, perception::NearFieldPa
   r.number(n, path, "min_height_m", p.min_height_m, 0.0, 2.0, "m");
 }
 
+void read_hold(YamlReader& r, const YAML::Node& n, perception::HoldParams& p) {
+  const std::string path = "perception.hold";
+  if (!r.section(n, path, {"enabled", "max_age_s", "gate_m", "min_points"})) return;
+  if (auto e = r.choice(n, path, "enabled", {"false", "true"})) p.enabled = *e == 1;
+  r.number(n, path, "max_age_s", p.max_age_s, 0.0, 2.0, "s");
+  r.number(n, path, "gate_m", p.gate_m, 0.0, 3.0, "m");
+  r.integer(n, path, "min_points", p.min_points, 1, 1000);
+}
+
 void read_perception(YamlReader& r, const YAML::Node& n, perception::PipelineParams& p) {
   const std::string path = "perception";
-  if (!r.section(n, path, {"voxel", "roi", "body", "ground", "cluster", "filters", "near_field"})) return;
+  if (!r.section(n, path, {"voxel", "roi", "body", "ground", "cluster", "filters", "near_field", "hold"})) return;
 
   read_voxel(r, n["voxel"], p.voxel);
   read_box(r, n["roi"], "perception.roi", p.roi);
@@ -363,6 +372,7 @@ void read_perception(YamlReader& r, const YAML::Node& n, perception::PipelinePar
   read_cluster(r, n["cluster"], p.cluster);
   read_filters(r, n["filters"], p.filters);
   read_near_field(r, n["near_field"], p.near_field);
+  read_hold(r, n["hold"], p.hold);
 }
 
 LoadResult load(const std::string& text, const std::string& name, const std::string& config_dir) {

@@ -130,6 +130,8 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
     s += '"';
     // Only frames that carry a 2D scan can have it: a 3D LiDAR's output keeps its old bytes.
     if ((o.sources & perception::kSeenBy2d) != 0) s += (o.sources & perception::kSeenBy3d) != 0 ? ",\"seen_by\":\"3d+2d\"" : ",\"seen_by\":\"2d\"";
+    // Only where the hold reported it (obstacle_hold.hpp): the filters' obstacles keep their bytes.
+    if (o.held) s += ",\"held\":true";
     if (plane) plane_json(s, o, *fusion, *lidar);
     s += '}';
   }

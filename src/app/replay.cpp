@@ -36,6 +36,7 @@
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/pcap_reader.hpp"
 #include "fieldguard/output/can_sink.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/sync/ordered_pool.hpp"
 #include "fieldguard/sync/synchronizer.hpp"
 
@@ -360,6 +361,9 @@ int cmd_replay(const std::vector<std::string>& argv) {
     if (!bev_dir.empty()) out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg.perception, std::nullopt);
     return out;
   };
+  // Frame to frame, so here in frame order and not in the workers (obstacle_hold.hpp).
+  perception::ObstacleHold hold(cfg.perception.hold);
+  std::uint64_t held_total = 0;
   auto deliver = [&](const Pool::Result& r) {
     if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
       // Replay uses the non-dropping submit, so this is a failed pipeline run; it is reported, never skipped.
@@ -382,7 +386,9 @@ int cmd_replay(const std::vector<std::string>& argv) {
       if (write_error.empty()) ++written;
     }
     if (!detect) return;
-    const perception::FrameResult& result = r.output->det.result;
+    perception::FrameResult& result = r.output->det.result;
+    hold.apply(f.host_stamp.ns, result);
+    held_total += result.counts.held;
     obstacles_total += result.obstacles.size();
     times.push_back(result.times);
     if (obstacles_out.is_open() && write_error.empty()) {
@@ -506,7 +512,11 @@ int cmd_replay(const std::vector<std::string>& argv) {
   print_summary(pcap_path, pcap_stats, stream, pos, ports, written, wall_s,
                 static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
   if (detect) {
-    std::printf("  obstacles         %llu\n", static_cast<unsigned long long>(obstacles_total));
+    std::printf("  obstacles         %llu", static_cast<unsigned long long>(obstacles_total));
+    if (cfg.perception.hold.enabled) {
+      std::printf(" (%llu of them held from fragments)", static_cast<unsigned long long>(held_total));
+    }
+    std::printf("\n");
     print_stage_times(times);
   }
   std::printf("  workers           %zu, %llu frames lost\n", workers, static_cast<unsigned long long>(lost));

@@ -37,6 +37,7 @@
 #include "fieldguard/io/udp_receiver.hpp"
 #include "fieldguard/output/can_sink.hpp"
 #include "fieldguard/output/can_speed.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/sync/health.hpp"
 #include "fieldguard/sync/ordered_pool.hpp"
@@ -303,6 +304,7 @@ class Session {
     std::printf("run summary: %s\n", cfg_.source_file.c_str());
     std::printf("  frames            %llu decided, %llu lost\n", u(c.frames), u(lost_));
     std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", u(c.stop_frames), u(c.go_frames), u(c.changes));
+    if (cfg_.perception.hold.enabled) std::printf("  held obstacles    %llu (from fragments)\n", u(held_));
     std::printf("  pool              %llu submitted, %llu dropped, %llu refused, %llu failed\n", u(pc.submitted),
                 u(pc.dropped), u(pc.refused), u(pc.failed));
     std::printf("  3d lidar          %llu packets, %llu decoded, %llu bad length, %llu full rotations, %llu partial\n",
@@ -399,6 +401,9 @@ class Session {
     timed_.push_back(t);
     worst_us_ = std::max(worst_us_, t.total_us);
     ++timed_count_;
+    // Frame to frame, so here in frame order (obstacle_hold.hpp); a rotation lost in between only ages what it
+    // remembers.
+    held_ += hold_.apply(r.output->frame.host_stamp.ns, r.output->result);
     stage_.frame(r.output->frame, r.output->result, r.input->complete, wall_clock_now(), lost_);
     if (ready_) notify_.progress(SteadyClock::now());
   }
@@ -409,6 +414,8 @@ class Session {
   bool& ready_;
   std::shared_ptr<spdlog::logger> log_ = logger("run");
   LiveStage stage_;
+  perception::ObstacleHold hold_{cfg_.perception.hold};
+  std::uint64_t held_ = 0;  // obstacles the hold reported
   SensorFusion fusion_;
   sync::HealthMonitor health_;
   DetectorSet detectors_;

@@ -56,6 +56,7 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.cluster.join_float_height_m, 0.0);
   EXPECT_EQ(p.cluster.split_min_length_m, 0.0);
   EXPECT_FALSE(p.near_field.enabled);  // the published method had no 2D LiDAR
+  EXPECT_FALSE(p.hold.enabled);        // nor carried anything from one rotation to the next
   // And it is what the perception module calls the published method.
   const auto pub = perception::published_params();
   EXPECT_EQ(p.ground.method, pub.ground.method);
@@ -67,6 +68,7 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.filters.max_points, pub.filters.max_points);
   EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, pub.filters.min_volume_m3);
   EXPECT_EQ(p.near_field.enabled, pub.near_field.enabled);
+  EXPECT_EQ(p.hold.enabled, pub.hold.enabled);
 }
 
 TEST(ConfigFiles, FieldguardUsesTheFieldMethods) {
@@ -164,6 +166,10 @@ TEST(ConfigFiles, FieldguardIsThePerceptionDefaults) {
   EXPECT_EQ(p.near_field.max_gap_m, d.near_field.max_gap_m);
   EXPECT_EQ(p.near_field.min_points, d.near_field.min_points);
   EXPECT_EQ(p.near_field.min_height_m, d.near_field.min_height_m);
+  EXPECT_EQ(p.hold.enabled, d.hold.enabled);
+  EXPECT_EQ(p.hold.max_age_s, d.hold.max_age_s);
+  EXPECT_EQ(p.hold.gate_m, d.hold.gate_m);
+  EXPECT_EQ(p.hold.min_points, d.hold.min_points);
 }
 
 TEST(ConfigLoad, ReadsEveryPerceptionKey) {
@@ -196,6 +202,7 @@ perception:
             min_points_full_range_m: 15, min_points_floor: 2}
   near_field: {enabled: false, zone: {min: [1, -3, -2.5], max: [10, 3, 0.5]}, max_gap_m: 0.25, min_points: 4,
                min_height_m: 0.2}
+  hold: {enabled: false, max_age_s: 0.25, gate_m: 0.8, min_points: 4}
 )",
                                   "t.yaml");
   ASSERT_TRUE(r.ok()) << dump(r);
@@ -246,6 +253,36 @@ perception:
   EXPECT_DOUBLE_EQ(nf.max_gap_m, 0.25);
   EXPECT_EQ(nf.min_points, 4);
   EXPECT_DOUBLE_EQ(nf.min_height_m, 0.2);
+  const auto& h = p.hold;
+  EXPECT_FALSE(h.enabled);
+  EXPECT_DOUBLE_EQ(h.max_age_s, 0.25);
+  EXPECT_DOUBLE_EQ(h.gate_m, 0.8);
+  EXPECT_EQ(h.min_points, 4);
+}
+
+// The hold (obstacle_hold.hpp): left out, fieldguard.yaml's values; out of range, each with its line.
+TEST(ConfigLoad, TheHoldKeys) {
+  const auto d = load_config_text("perception: {}\n", "t.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_TRUE(d.config.perception.hold.enabled);
+  EXPECT_EQ(d.config.perception.hold.max_age_s, 0.35);
+  EXPECT_EQ(d.config.perception.hold.gate_m, 0.3);
+  EXPECT_EQ(d.config.perception.hold.min_points, 2);
+  const std::string text =
+      "perception:\n"            // 1
+      "  hold:\n"                // 2
+      "    enabled: maybe\n"     // 3 not true or false
+      "    max_age_s: -0.1\n"    // 4 out of range
+      "    gate_m: 4\n"          // 5 out of range
+      "    min_points: 0\n"      // 6 out of range
+      "    max_age: 1\n";        // 7 unknown
+  const auto r = load_config_text(text, "bad.yaml");
+  EXPECT_TRUE(has_issue(r, "perception.hold.enabled", "is not one of", 3)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.hold.max_age_s", "out of range", 4)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.hold.gate_m", "out of range", 5)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.hold.min_points", "out of range", 6)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "perception.hold.max_age", "unknown key", 7)) << dump(r);
+  EXPECT_EQ(r.issues.size(), 5U) << dump(r);
 }
 
 // 0 switches the upper limits off, so a large minimum with a zero maximum is no contradiction.

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,8 @@ constexpr int kOrchardRotations = 40;
 struct Outcome {
   ScoreReport report;
   std::string log;
+  std::string summary;    // replay's stdout
+  std::string obstacles;  // the obstacles.jsonl
 };
 
 Outcome sim_replay_score(const std::string& config, const ScratchDir& dir, const std::string& scene = "rough-pedestrian",
@@ -44,6 +47,8 @@ Outcome sim_replay_score(const std::string& config, const ScratchDir& dir, const
                                                  "' --obstacles-out '" + obstacles + "'");
   EXPECT_EQ(replay.exit_code, 0) << replay.errors;
   o.log = sim.errors + replay.errors;
+  o.summary = replay.output;
+  o.obstacles = tools_test::read_file(obstacles);
   std::vector<TruthFrame> t;
   std::vector<DetectionFrame> d;
   std::string error;
@@ -103,6 +108,52 @@ TEST(SimScorePipeline, OrchardCrownsWithOurConfig) {
   EXPECT_LE(c.merged * 200, c.visible) << "crowns merged: " << c.merged;
   EXPECT_LE(c.split * 100, c.visible) << "crowns split: " << c.split;
   EXPECT_LE(c.false_obstacles * 200, c.obstacles) << "false obstacles among crowns: " << c.false_obstacles;
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// The hold (obstacle_hold.hpp) in replay: the orchard's first ten seconds with and without it, the same capture.
+// Measured: 10 obstacles held, 6 more crown frames detected (3,343 against 3,337 of 3,401), no false obstacle
+// either way. Held obstacles are flagged in the JSON and counted in the summary; each is a crown (a held
+// obstacle on nothing would be a false one) and none splits a crown the filters reported. A hold that is not
+// called, not written, or that makes its boxes anywhere but on the fragments fails it.
+TEST(SimScorePipeline, OrchardHoldReportsCrownsSeenThroughGaps) {
+  constexpr int kHoldRotations = 100;
+  const ScratchDir dir("sim_score_hold");
+  const std::string ours = std::string(FIELDGUARD_CONFIG_DIR) + "/fieldguard.yaml";
+  std::string text = tools_test::read_file(ours);
+  const std::string on = "  hold:";
+  const std::size_t at = text.find("    enabled: true", text.find(on));
+  ASSERT_NE(text.find(on), std::string::npos);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 17, "    enabled: false");
+  const std::string off = dir.file("no-hold.yaml");
+  {
+    std::ofstream f(off);
+    f << text;
+  }
+  const Outcome with = sim_replay_score(ours, dir, "orchard", kHoldRotations);
+  const Outcome without = sim_replay_score(off, dir, "orchard", kHoldRotations);
+  ASSERT_GE(with.report.scored_frames, static_cast<std::size_t>(kHoldRotations - 2)) << with.log;
+
+  const std::size_t held = count_of(with.obstacles, "\"held\":true");
+  EXPECT_GE(held, 5U);
+  EXPECT_NE(with.summary.find("(" + std::to_string(held) + " of them held from fragments)"), std::string::npos)
+      << with.summary;
+  EXPECT_EQ(count_of(without.obstacles, "\"held\""), 0U);
+  EXPECT_EQ(without.summary.find("held"), std::string::npos) << without.summary;
+
+  const Rate& a = with.report.classes.at("crown");
+  const Rate& b = without.report.classes.at("crown");
+  EXPECT_EQ(a.total, b.total);
+  EXPECT_GE(a.hits, b.hits + 3) << "crown frames detected: " << a.hits << " with the hold, " << b.hits << " without";
+  EXPECT_EQ(with.report.false_obstacles, without.report.false_obstacles);
+  EXPECT_GE(with.report.crowns.tp, without.report.crowns.tp + 3);
+  EXPECT_EQ(with.report.crowns.split, without.report.crowns.split);
 }
 
 }  // namespace
