@@ -54,6 +54,7 @@
 #include "fieldguard/perception/crop.hpp"
 #include "fieldguard/perception/euclidean_cluster.hpp"
 #include "fieldguard/perception/near_field.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/perception/ransac_ground.hpp"
 #include "fieldguard/perception/voxel_grid.hpp"
@@ -273,7 +274,8 @@ std::vector<Row>& rows() {
 // their own (warm). `pcl` may be empty (no stock-PCL counterpart).
 constexpr int kRuns = 3;
 void paired(benchmark::State& state, const std::string& stage, int which, std::size_t points_in,
-            const std::function<void()>& ours, const std::function<void()>& pcl) {
+            const std::function<void()>& ours, const std::function<void()>& pcl,
+            const std::string* frame_name = nullptr) {
   std::vector<double> o_cpu, p_cpu, o_cold, p_cold, o_wall, p_wall;
   using clock = std::chrono::steady_clock;
   const auto timed = [](const std::function<void()>& f, double& cpu_us, double& wall_us) {
@@ -301,8 +303,9 @@ void paired(benchmark::State& state, const std::string& stage, int which, std::s
       if (r > 0) p_wall.push_back(wall);
     }
   }
-  Row row{stage,          frame(which).name, points_in,      median(o_cpu), median(p_cpu),
-          median(o_cold), median(p_cold),    median(o_wall), median(p_wall)};
+  const std::string& name = frame_name != nullptr ? *frame_name : frame(which).name;
+  Row row{stage,          name,           points_in,      median(o_cpu), median(p_cpu),
+          median(o_cold), median(p_cold), median(o_wall), median(p_wall)};
   state.counters["points_in"] = static_cast<double>(points_in);
   state.counters["ours_us"] = row.ours_cpu;
   state.counters["ours_cold_us"] = row.ours_cold;
@@ -657,13 +660,14 @@ void BM_PipelineFieldguardNoSurroundings(benchmark::State& state) {
 }
 
 // Packets to obstacles: the UDP payloads of the rotation into velodyne::Stream, the rotation it emits through
-// the fieldguard.yaml pipeline. The stream and the pipeline live across runs as in the daemon: each run pushes
+// the fieldguard.yaml pipeline and its hold (which the daemon runs on its io thread, after the worker). The stream and the pipeline live across runs as in the daemon: each run pushes
 // the rotation's packets, and the first packet (azimuth 0) completes the rotation pushed by the run before,
 // which is then processed; frame buffers go back to the stream. One rotation decoded and detected per run.
 void BM_PacketsToObstacles(benchmark::State& state) {
   Frame& f = frame(static_cast<int>(state.range(0)));
   velodyne::Stream stream(bench::sim_stream_options());
   Pipeline pipe(fieldguard_params());
+  ObstacleHold hold(fieldguard_params().hold);
   std::vector<LidarFrame> done;
   std::vector<StageTimes> times;  // the pipeline's own stage times of every rotation processed
   std::size_t processed = 0, obstacles = 0;
@@ -672,7 +676,8 @@ void BM_PacketsToObstacles(benchmark::State& state) {
     done.clear();
     for (const auto& p : f.packets) stream.push(ByteSpan(p.bytes.data(), p.bytes.size()), Stamp{p.pcap_time_ns}, done);
     for (const auto& d : done) {
-      const auto r = pipe.process(d.points);
+      auto r = pipe.process(d.points);
+      (void)hold.apply(d.host_stamp.ns, r);
       obstacles = r.obstacles.size();
       times.push_back(r.times);
       ++processed;
@@ -749,6 +754,36 @@ std::vector<LidarPoint> bumper_scan() {
     out.push_back(p);
   }
   return out;
+}
+
+// The hold (obstacle_hold.hpp; no PCL counterpart) with fieldguard.yaml's keys, on a frame's own fragments: every
+// obstacle of the frame remembered, then each run the same frame with every second obstacle gone, so that half
+// of them are looked for among the fragments. Frame 4 is an orchard rotation (10 Hz: crowns seen through the
+// gaps of nearer rows, the most fragments). A run includes putting the frame's obstacles back (a copy of a few
+// dozen).
+void BM_ObstacleHold(benchmark::State& state) {
+  static Frame orchard = make_frame(FrameSpec{"orchard 10Hz", "orchard", 10.0, 3, 12});
+  const int which = static_cast<int>(state.range(0));
+  Frame& f = which < kFrameCount ? frame(which) : orchard;
+  Pipeline pipe(fieldguard_params());
+  const FrameResult full = pipe.process(f.points);
+  std::vector<Obstacle> half;
+  for (std::size_t i = 0; i < full.obstacles.size(); i += 2) half.push_back(full.obstacles[i]);
+  ObstacleHold hold(fieldguard_params().hold);
+  FrameResult work = full;
+  std::int64_t stamp = 0;
+  (void)hold.apply(stamp, work);
+  std::size_t held = 0;
+  paired(
+      state, "hold (half the obstacles gone)", which < kFrameCount ? which : 0, full.fragments.size(),
+      [&] {
+        work.obstacles.assign(half.begin(), half.end());
+        held = hold.apply(++stamp, work);  // 1 ns later: nothing ages out
+      },
+      {}, &f.name);
+  state.counters["obstacles"] = static_cast<double>(full.obstacles.size());
+  state.counters["fragments"] = static_cast<double>(full.fragments.size());
+  state.counters["held"] = static_cast<double>(held);
 }
 
 void BM_NearField(benchmark::State& state) {
@@ -829,6 +864,11 @@ FG_BENCH(BM_PipelineFieldguardNoSurroundings);
 FG_BENCH(BM_Decode);
 FG_BENCH(BM_PacketsToObstacles);
 FG_BENCH(BM_NearField);
+BENCHMARK(BM_ObstacleHold)
+    ->DenseRange(0, kFrameCount)
+    ->UseManualTime()
+    ->Iterations(kIterations)
+    ->Unit(benchmark::kMicrosecond);
 FG_BENCH(BM_PipelineWithScan);
 
 void print_summary() {
