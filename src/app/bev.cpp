@@ -63,8 +63,17 @@ Image render_bev(std::span<const perception::LabeledPoint> points, const percept
     rect(img, p, stop_zone->min[0], stop_zone->min[1], stop_zone->max[0], stop_zone->max[1], {255, 60, 200});
   }
 
-  for (const auto& o : result.obstacles) {
-    const Rgb c = o.size_class == perception::SizeClass::Small ? Rgb{255, 50, 50} : Rgb{255, 150, 40};
+  draw_obstacles(img, result.obstacles, view);
+  return img;
+}
+
+void draw_obstacles(Image& img, std::span<const perception::Obstacle> obstacles, const BevView& view) {
+  const Projector p{view};
+  for (const auto& o : obstacles) {
+    // Held (obstacle_hold.hpp): cyan, and said so under the distance.
+    const Rgb c = o.held                                         ? Rgb{60, 220, 255}
+                  : o.size_class == perception::SizeClass::Small ? Rgb{255, 50, 50}
+                                                                 : Rgb{255, 150, 40};
     const double cy = std::cos(static_cast<double>(o.obb_yaw_rad));
     const double sy = std::sin(static_cast<double>(o.obb_yaw_rad));
     const double hl = static_cast<double>(o.obb_length_m) / 2.0;
@@ -80,9 +89,10 @@ Image render_bev(std::span<const perception::LabeledPoint> points, const percept
     }
     char label[32];
     std::snprintf(label, sizeof label, "%.1fm", static_cast<double>(o.distance_m));
-    img.text(p.col(static_cast<double>(o.max[1])), p.row(static_cast<double>(o.max[0])) - 9, label, {255, 255, 255});
+    const int col = p.col(static_cast<double>(o.max[1])), row = p.row(static_cast<double>(o.max[0]));
+    img.text(col, row - 9, label, {255, 255, 255});
+    if (o.held) img.text(col, row + 1, "held", c);
   }
-  return img;
 }
 
 }  // namespace fieldguard::app

@@ -364,6 +364,7 @@ int cmd_replay(const std::vector<std::string>& argv) {
   // Frame to frame, so here in frame order and not in the workers (obstacle_hold.hpp).
   perception::ObstacleHold hold(cfg.perception.hold);
   std::uint64_t held_total = 0;
+  std::vector<perception::Obstacle> held;  // one frame's held obstacles, for its picture
   auto deliver = [&](const Pool::Result& r) {
     if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
       // Replay uses the non-dropping submit, so this is a failed pipeline run; it is reported, never skipped.
@@ -389,6 +390,13 @@ int cmd_replay(const std::vector<std::string>& argv) {
     perception::FrameResult& result = r.output->det.result;
     hold.apply(f.host_stamp.ns, result);
     held_total += result.counts.held;
+    if (result.counts.held > 0 && r.output->bev) {
+      held.clear();
+      for (const auto& o : result.obstacles) {
+        if (o.held) held.push_back(o);
+      }
+      draw_obstacles(*r.output->bev, held);
+    }
     obstacles_total += result.obstacles.size();
     times.push_back(result.times);
     if (obstacles_out.is_open() && write_error.empty()) {
