@@ -1,9 +1,10 @@
 #pragma once
 // Holding a recent obstacle's place (HoldParams, params.hpp): a hysteresis in time. The filters ask a cluster
 // for enough points to tell it from dust and single stray returns; where they reported an obstacle less than
-// max_age_s ago, fewer will do. If no obstacle of this frame comes within gate_m of that obstacle's box, the
-// frame's fragments (FrameResult::fragments: groups too few for the filters, standing high enough) within
-// gate_m of it are reported as one obstacle, when they hold min_points points together.
+// max_age_s ago, fewer will do. If no obstacle of this frame stands in that obstacle's place (overlapping its box
+// in z, and in x and y by half the shorter extent: a neighbour within gate_m is not it), the frame's fragments
+// (FrameResult::fragments: groups too few for the filters, standing high enough) within gate_m of its box and in
+// no box of this frame are reported as one obstacle, when they hold min_points points together.
 //
 // Only the filters' obstacles are remembered: a held obstacle holds nothing, so an obstacle the filters have
 // not reported for max_age_s is let go whatever its fragments. Boxes are compared in the sensor frame: the
