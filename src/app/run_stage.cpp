@@ -31,6 +31,13 @@ void LiveStage::sensor_data(safety::Sensor s, Stamp t) {
 
 void LiveStage::vehicle_speed(double speed_mps, Stamp t) { speed_ = {speed_mps, t}; }
 
+std::optional<double> LiveStage::speed_at(Stamp now) const {
+  if (speed_ && static_cast<double>(now.ns - speed_->second.ns) * 1e-9 <= cfg_.can.speed_timeout_s) {
+    return speed_->first;
+  }
+  return std::nullopt;
+}
+
 void LiveStage::sensor_problem(safety::Sensor s, safety::Problem p) {
   auto& slot = input_.sensors[static_cast<std::size_t>(s)].problem;
   if (slot == safety::Problem::None) slot = p;
@@ -50,9 +57,7 @@ const safety::Decision& LiveStage::frame(const LidarFrame& f, const perception::
   safety::FrameInput frame_in;
   frame_in.obstacles = result.obstacles;
   frame_in.data_end = data_end;
-  if (speed_ && static_cast<double>(now.ns - speed_->second.ns) * 1e-9 <= cfg_.can.speed_timeout_s) {
-    frame_in.speed_mps = speed_->first;
-  }
+  frame_in.speed_mps = speed_at(now);
   input_.frame = &frame_in;
   last_ = monitor_.update(input_);
   input_.frame = nullptr;

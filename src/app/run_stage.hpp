@@ -39,6 +39,8 @@ class LiveStage {
   // The tractor's speed from the bus, received at `t`; a frame decided within can.speed_timeout_s of it sizes
   // the stop zone with it (older: unknown, the zone's full-speed length).
   void vehicle_speed(double speed_mps, Stamp t);
+  // The last speed from the bus if received within can.speed_timeout_s before `now`; else unknown.
+  [[nodiscard]] std::optional<double> speed_at(Stamp now) const;
   // A GNSS or AHRS sample failed its plausibility check; the next decision (frame or tick) sees it.
   void sensor_problem(output::safety::Sensor s, output::safety::Problem p);
   // A finished rotation, decided at `now`; `data_end`: the receive time of the packet that completed it.

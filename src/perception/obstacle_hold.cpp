@@ -11,25 +11,29 @@ namespace fieldguard::perception {
 
 namespace {
 
-// Boxes [amin, amax] grown by `g` on every side and [bmin, bmax] share a point (closed boxes).
+// Boxes [amin, amax] grown by `g` on every side (and by `gx` more along x) and [bmin, bmax] share a point (closed
+// boxes).
 bool touch(const std::array<float, 3>& amin, const std::array<float, 3>& amax, float g,
-           const std::array<float, 3>& bmin, const std::array<float, 3>& bmax) {
+           const std::array<float, 3>& bmin, const std::array<float, 3>& bmax, float gx = 0.F) {
   for (std::size_t i = 0; i < 3; ++i) {
-    if (bmax[i] < amin[i] - g || bmin[i] > amax[i] + g) return false;
+    const float grow = i == 0 ? g + gx : g;
+    if (bmax[i] < amin[i] - grow || bmin[i] > amax[i] + grow) return false;
   }
   return true;
 }
 
 // Boxes that are one obstacle seen twice: overlapping in z, and in x and in y by at least half the shorter of the
 // two extents (0.05 m added to both sides, for boxes of a single return). Neighbouring crowns whose boxes come
-// within the gate of each other, or overlap by a sliver, are not.
+// within the gate of each other, or overlap by a sliver, are not. `ax` grows a's box along x on both sides first
+// (the distance driven since a was reported).
 bool same_place(const std::array<float, 3>& amin, const std::array<float, 3>& amax, const std::array<float, 3>& bmin,
-                const std::array<float, 3>& bmax) {
+                const std::array<float, 3>& bmax, float ax) {
   constexpr float kSingle = 0.05F;
   if (bmax[2] < amin[2] || bmin[2] > amax[2]) return false;
   for (std::size_t i = 0; i < 2; ++i) {
-    const float common = std::min(amax[i], bmax[i]) - std::max(amin[i], bmin[i]);
-    const float shorter = std::min(amax[i] - amin[i], bmax[i] - bmin[i]);
+    const float lo = i == 0 ? amin[i] - ax : amin[i], hi = i == 0 ? amax[i] + ax : amax[i];
+    const float common = std::min(hi, bmax[i]) - std::max(lo, bmin[i]);
+    const float shorter = std::min(hi - lo, bmax[i] - bmin[i]);
     if (common + kSingle < 0.5F * (shorter + kSingle)) return false;
   }
   return true;
@@ -48,8 +52,9 @@ ObstacleHold::ObstacleHold(const HoldParams& params) : params_(params) {
   max_age_ns_ = std::llround(params.max_age_s * 1e9);
 }
 
-std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result) {
+std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result, std::optional<double> speed_mps) {
   if (!params_.enabled) return 0;
+  const double speed = speed_mps && std::isfinite(*speed_mps) && *speed_mps > 0.0 ? *speed_mps : 0.0;
   if (any_frame_ && stamp_ns < last_ns_) seen_.clear();
   any_frame_ = true;
   last_ns_ = stamp_ns;
@@ -74,14 +79,15 @@ std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result) {
   next_.clear();
   std::size_t held = 0;
   for (const Seen& s : seen_) {
+    const auto driven = static_cast<float>(speed * static_cast<double>(stamp_ns - s.stamp_ns) * 1e-9);
     bool again = false;
     for (std::size_t o = 0; o < reported && !again; ++o) {
-      again = same_place(s.min, s.max, result.obstacles[o].min, result.obstacles[o].max);
+      again = same_place(s.min, s.max, result.obstacles[o].min, result.obstacles[o].max, driven);
     }
     if (again) continue;  // reported this frame: remembered from this frame's report
     next_.push_back(s);
 
-    const float x0 = s.min[0] - gate, x1 = s.max[0] + gate;
+    const float x0 = s.min[0] - gate - driven, x1 = s.max[0] + gate + driven;
     auto it = std::lower_bound(order_.begin(), order_.end(), x0 - widest,
                                [&](std::uint32_t f, float x) { return fragments[f].min[0] < x; });
     picked_.clear();
@@ -89,7 +95,7 @@ std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result) {
     for (; it != order_.end() && fragments[*it].min[0] <= x1; ++it) {
       const std::uint32_t f = *it;
       const Fragment& fr = fragments[f];
-      if (used_[f] != 0U || !touch(s.min, s.max, gate, fr.min, fr.max)) continue;
+      if (used_[f] != 0U || !touch(s.min, s.max, gate, fr.min, fr.max, driven)) continue;
       // Inside an obstacle of this frame's (a part the filters have already reported): not this one's.
       bool inside = false;
       for (std::size_t o = 0; o < reported && !inside; ++o) {

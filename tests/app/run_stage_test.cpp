@@ -146,5 +146,18 @@ TEST_F(LiveStageTest, AFreshBusSpeedSizesTheZoneAStaleOneDoesNot) {
   EXPECT_GT(d.zone.x_max_m, 10.5);
 }
 
+// What the daemon hands the hold (obstacle_hold.hpp) and the zone: the bus's speed while fresh, then unknown.
+TEST_F(LiveStageTest, SpeedAtIsTheBusSpeedWithinItsTimeout) {
+  LiveStage stage(cfg, sink);
+  EXPECT_FALSE(stage.speed_at(Stamp{t0}).has_value()) << "no speed heard yet";
+  stage.vehicle_speed(2.5, Stamp{t0});
+  const auto timeout = static_cast<std::int64_t>(cfg.can.speed_timeout_s * 1e9);
+  ASSERT_TRUE(stage.speed_at(Stamp{t0 + timeout}).has_value());
+  EXPECT_DOUBLE_EQ(*stage.speed_at(Stamp{t0 + timeout}), 2.5);
+  EXPECT_FALSE(stage.speed_at(Stamp{t0 + timeout + kMs}).has_value());
+  stage.vehicle_speed(0.5, Stamp{t0 + 2 * timeout});
+  EXPECT_DOUBLE_EQ(stage.speed_at(Stamp{t0 + 2 * timeout}).value_or(-1.0), 0.5);
+}
+
 }  // namespace
 }  // namespace fieldguard::app

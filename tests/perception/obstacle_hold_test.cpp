@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -194,6 +195,47 @@ TEST(ObstacleHold, KeepsTheObstaclesNearestFirst) {
   EXPECT_TRUE(next.obstacles[1].held);
   EXPECT_FALSE(next.obstacles[2].held);
   EXPECT_FLOAT_EQ(next.obstacles[2].min[0], 30.F);
+}
+
+// At 3 m/s the crown comes 0.6 m nearer in 0.2 s: its fragments are beyond the 0.3 m gate unless the speed is
+// given, which grows the gate along x (either way: the bus's speed has no sign) by the distance driven.
+TEST(ObstacleHold, TheGateGrowsAlongXWithTheDistanceDriven) {
+  const std::vector<Fragment> nearer{fragment({14.45F, 8.F, 1.F}, {14.5F, 8.2F, 1.F}, 2)};   // 0.5 m short of it
+  const std::vector<Fragment> beside{fragment({16.F, 9.45F, 1.F}, {16.1F, 9.5F, 1.F}, 2)};  // 0.45 m off in y
+  for (const std::optional<double> speed : {std::optional<double>{}, std::optional<double>{3.0}}) {
+    ObstacleHold hold(params());
+    FrameResult f0 = frame({kCrown});
+    (void)hold.apply(0, f0);
+    FrameResult f1 = frame({}, nearer);
+    EXPECT_EQ(hold.apply(2 * kPeriod, f1, speed), speed ? 1U : 0U) << (speed ? "3 m/s" : "speed unknown");
+    FrameResult f2 = frame({}, beside);
+    EXPECT_EQ(hold.apply(3 * kPeriod, f2, speed), 0U) << "y does not grow";
+  }
+  // Unusable speeds count as unknown.
+  for (const double bad : {-3.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    ObstacleHold hold(params());
+    FrameResult f0 = frame({kCrown});
+    (void)hold.apply(0, f0);
+    FrameResult f1 = frame({}, nearer);
+    EXPECT_EQ(hold.apply(2 * kPeriod, f1, bad), 0U) << bad;
+  }
+}
+
+// At speed the filters' report of the same obstacle has moved by the distance driven: it is still the obstacle
+// reported again (no fragment beside it is held), when the speed is given.
+TEST(ObstacleHold, AtSpeedTheMovedReportIsTheSameObstacle) {
+  const Obstacle person = box({10.F, 0.F, -0.9F}, {10.5F, 0.5F, 0.8F});
+  Obstacle moved = person;
+  moved.min[0] -= 0.3F;  // 3 m/s, one rotation at 10 Hz
+  moved.max[0] -= 0.3F;
+  const std::vector<Fragment> arm{fragment({10.25F, 0.55F, 0.3F}, {10.4F, 0.7F, 0.4F}, 2)};
+  for (const std::optional<double> speed : {std::optional<double>{}, std::optional<double>{3.0}}) {
+    ObstacleHold hold(params());
+    FrameResult f0 = frame({person});
+    (void)hold.apply(0, f0);
+    FrameResult f1 = frame({moved}, arm);
+    EXPECT_EQ(hold.apply(kPeriod, f1, speed), speed ? 0U : 1U) << (speed ? "3 m/s" : "speed unknown");
+  }
 }
 
 // A stamp before the last frame's (another capture, a clock step): everything remembered is forgotten.

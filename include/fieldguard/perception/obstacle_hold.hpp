@@ -8,13 +8,14 @@
 //
 // Only the filters' obstacles are remembered: a held obstacle holds nothing, so an obstacle the filters have
 // not reported for max_age_s is let go whatever its fragments. Boxes are compared in the sensor frame: the
-// tractor's travel over max_age_s must fit in gate_m.
+// tractor's travel since the report must fit in the gate, which grows along x with it when the speed is given.
 //
 // Stateful across frames, so it runs where the frames are in order (replay's and the daemon's delivery), not in
 // the workers' Pipeline. Thread-compatible.
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "fieldguard/perception/obstacle.hpp"
@@ -30,8 +31,10 @@ class ObstacleHold {
   // The frame of `result`, stamped `stamp_ns` (its first packet's time; frames come in order). Adds the held
   // obstacles to result.obstacles (sorted again, sort_obstacles) and counts them in result.counts.held; returns
   // how many. A stamp before the last frame's forgets every obstacle (a new capture, or the clock stepped).
-  // Disabled: does nothing.
-  std::size_t apply(std::int64_t stamp_ns, FrameResult& result);
+  // `speed_mps`, when known (the tractor's, from the bus): a remembered obstacle's gate grows along x by the
+  // distance driven since its report, forwards and backwards alike (the speed has no sign). A negative or
+  // non-finite speed counts as unknown. Disabled: does nothing.
+  std::size_t apply(std::int64_t stamp_ns, FrameResult& result, std::optional<double> speed_mps = std::nullopt);
 
   // The obstacles remembered (for tests).
   [[nodiscard]] std::size_t remembered() const { return seen_.size(); }

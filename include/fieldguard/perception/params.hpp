@@ -210,7 +210,7 @@ struct HoldParams {
   double max_age_s = 0.35;
   // Fragments count when their box comes this near the held box (m). The held box is where the obstacle was
   // in the sensor frame: the tractor's travel over max_age_s must fit in it (0.3 m: 0.85 m/s at 0.35 s, the
-  // orchard's crawl; raise it for faster work).
+  // orchard's crawl), unless its speed is known (ObstacleHold::apply), which widens it along x by the travel.
   double gate_m = 0.3;
   // Points the fragments within the gate must hold together: the filters' own least far out (min_points_floor).
   int min_points = 2;
