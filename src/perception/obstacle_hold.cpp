@@ -39,7 +39,38 @@ bool same_place(const std::array<float, 3>& amin, const std::array<float, 3>& am
   return true;
 }
 
+bool finite(const FramePose& p) {
+  return std::isfinite(p.x_m) && std::isfinite(p.y_m) && std::isfinite(p.z_m) && std::isfinite(p.yaw_rad);
+}
+
 }  // namespace
+
+// Through the plane (p_plane = origin + Rz(yaw) p) corner by corner, in double: plane coordinates are millions
+// of metres.
+void move_box(const std::array<float, 3>& min, const std::array<float, 3>& max, const FramePose& from,
+              const FramePose& to, std::array<float, 3>& out_min, std::array<float, 3>& out_max) {
+  const double c0 = std::cos(from.yaw_rad), s0 = std::sin(from.yaw_rad);
+  const double c1 = std::cos(to.yaw_rad), s1 = std::sin(to.yaw_rad);
+  const double dx = from.x_m - to.x_m, dy = from.y_m - to.y_m;
+  double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+  for (const double x : {static_cast<double>(min[0]), static_cast<double>(max[0])}) {
+    for (const double y : {static_cast<double>(min[1]), static_cast<double>(max[1])}) {
+      const double px = dx + c0 * x - s0 * y, py = dy + s0 * x + c0 * y;  // from `to`'s origin, plane axes
+      const double q[2] = {c1 * px + s1 * py, -s1 * px + c1 * py};        // in `to`'s axes
+      for (std::size_t i = 0; i < 2; ++i) {
+        lo[i] = std::min(lo[i], q[i]);
+        hi[i] = std::max(hi[i], q[i]);
+      }
+    }
+  }
+  const double dz = from.z_m - to.z_m;
+  for (std::size_t i = 0; i < 2; ++i) {
+    out_min[i] = static_cast<float>(lo[i]);
+    out_max[i] = static_cast<float>(hi[i]);
+  }
+  out_min[2] = static_cast<float>(static_cast<double>(min[2]) + dz);
+  out_max[2] = static_cast<float>(static_cast<double>(max[2]) + dz);
+}
 
 ObstacleHold::ObstacleHold(const HoldParams& params) : params_(params) {
   if (!std::isfinite(params.max_age_s) || params.max_age_s < 0.0) {
@@ -52,9 +83,11 @@ ObstacleHold::ObstacleHold(const HoldParams& params) : params_(params) {
   max_age_ns_ = std::llround(params.max_age_s * 1e9);
 }
 
-std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result, std::optional<double> speed_mps) {
+std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result, std::optional<double> speed_mps,
+                                const std::optional<FramePose>& pose) {
   if (!params_.enabled) return 0;
   const double speed = speed_mps && std::isfinite(*speed_mps) && *speed_mps > 0.0 ? *speed_mps : 0.0;
+  const std::optional<FramePose> here = pose && finite(*pose) ? pose : std::nullopt;
   if (any_frame_ && stamp_ns < last_ns_) seen_.clear();
   any_frame_ = true;
   last_ns_ = stamp_ns;
@@ -79,15 +112,22 @@ std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result, std:
   next_.clear();
   std::size_t held = 0;
   for (const Seen& s : seen_) {
-    const auto driven = static_cast<float>(speed * static_cast<double>(stamp_ns - s.stamp_ns) * 1e-9);
+    // Its box where it stands in this frame: moved there by the two poses, or as reported, with the distance
+    // driven since as slack along x.
+    std::array<float, 3> smin = s.min, smax = s.max;
+    auto driven = static_cast<float>(speed * static_cast<double>(stamp_ns - s.stamp_ns) * 1e-9);
+    if (here && s.pose && s.pose->plane == here->plane) {
+      move_box(s.min, s.max, *s.pose, *here, smin, smax);
+      driven = 0.F;
+    }
     bool again = false;
     for (std::size_t o = 0; o < reported && !again; ++o) {
-      again = same_place(s.min, s.max, result.obstacles[o].min, result.obstacles[o].max, driven);
+      again = same_place(smin, smax, result.obstacles[o].min, result.obstacles[o].max, driven);
     }
     if (again) continue;  // reported this frame: remembered from this frame's report
     next_.push_back(s);
 
-    const float x0 = s.min[0] - gate - driven, x1 = s.max[0] + gate + driven;
+    const float x0 = smin[0] - gate - driven, x1 = smax[0] + gate + driven;
     auto it = std::lower_bound(order_.begin(), order_.end(), x0 - widest,
                                [&](std::uint32_t f, float x) { return fragments[f].min[0] < x; });
     picked_.clear();
@@ -95,7 +135,7 @@ std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result, std:
     for (; it != order_.end() && fragments[*it].min[0] <= x1; ++it) {
       const std::uint32_t f = *it;
       const Fragment& fr = fragments[f];
-      if (used_[f] != 0U || !touch(s.min, s.max, gate, fr.min, fr.max, driven)) continue;
+      if (used_[f] != 0U || !touch(smin, smax, gate, fr.min, fr.max, driven)) continue;
       // Inside an obstacle of this frame's (a part the filters have already reported): not this one's.
       bool inside = false;
       for (std::size_t o = 0; o < reported && !inside; ++o) {
@@ -137,7 +177,7 @@ std::size_t ObstacleHold::apply(std::int64_t stamp_ns, FrameResult& result, std:
     ++held;
   }
   for (std::size_t o = 0; o < reported; ++o) {
-    next_.push_back(Seen{result.obstacles[o].min, result.obstacles[o].max, stamp_ns});
+    next_.push_back(Seen{result.obstacles[o].min, result.obstacles[o].max, stamp_ns, here});
   }
   seen_.swap(next_);
   if (held > 0) sort_obstacles(result.obstacles);

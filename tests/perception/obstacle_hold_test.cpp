@@ -238,6 +238,150 @@ TEST(ObstacleHold, AtSpeedTheMovedReportIsTheSameObstacle) {
   }
 }
 
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+std::array<float, 3> centre(const std::array<float, 3>& min, const std::array<float, 3>& max) {
+  return {0.5F * (min[0] + max[0]), 0.5F * (min[1] + max[1]), 0.5F * (min[2] + max[2])};
+}
+
+// move_box against what a driver sees: a post straight ahead comes nearer by the distance driven; turning left
+// by an angle swings it to the right by that angle; climbing lowers it; a box turned by 90 degrees swaps its
+// extents. Plane coordinates of a Gauss-Krueger zone (millions of metres) lose nothing that matters.
+TEST(ObstacleHold, MoveBoxTakesTheCornersThroughThePlane) {
+  const std::array<float, 3> post_min{20.F, -0.05F, -1.F}, post_max{20.F, 0.05F, 1.F};
+  std::array<float, 3> mn{}, mx{};
+  for (const double yaw : {0.0, 30.0, -135.0}) {
+    const FramePose from{3'512'345.25, 5'401'234.75, 312.5, yaw * kDeg, 33};
+    // 1.5 m along the heading, 0.4 m up.
+    FramePose ahead = from;
+    ahead.x_m += 1.5 * std::cos(from.yaw_rad);
+    ahead.y_m += 1.5 * std::sin(from.yaw_rad);
+    ahead.z_m += 0.4;
+    move_box(post_min, post_max, from, ahead, mn, mx);
+    EXPECT_NEAR(mn[0], 18.5F, 1e-4) << yaw;
+    EXPECT_NEAR(mx[0], 18.5F, 1e-4) << yaw;
+    EXPECT_NEAR(mn[1], -0.05F, 1e-4) << yaw;
+    EXPECT_NEAR(mx[1], 0.05F, 1e-4) << yaw;
+    EXPECT_NEAR(mn[2], -1.4F, 1e-4) << yaw;
+    EXPECT_NEAR(mx[2], 0.6F, 1e-4) << yaw;
+    // Turned 10 degrees left where it stands.
+    FramePose left = from;
+    left.yaw_rad += 10.0 * kDeg;
+    move_box(post_min, post_max, from, left, mn, mx);
+    const auto c = centre(mn, mx);
+    EXPECT_NEAR(c[0], 20.0 * std::cos(10.0 * kDeg), 1e-4) << yaw;
+    EXPECT_NEAR(c[1], -20.0 * std::sin(10.0 * kDeg), 1e-4) << yaw;
+    EXPECT_NEAR(c[2], 0.F, 1e-6) << yaw;
+    // Not moved at all: the same box.
+    move_box(post_min, post_max, from, from, mn, mx);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_NEAR(mn[i], post_min[i], 1e-5) << yaw;
+      EXPECT_NEAR(mx[i], post_max[i], 1e-5) << yaw;
+    }
+  }
+  // A 2 m by 0.5 m box seen after a quarter turn left: 0.5 by 2, on the right.
+  const FramePose a{100.0, 200.0, 0.0, 0.0, 1};
+  const FramePose b{100.0, 200.0, 0.0, 90.0 * kDeg, 1};
+  move_box({10.F, 0.F, 0.F}, {12.F, 0.5F, 1.F}, a, b, mn, mx);
+  EXPECT_NEAR(mn[0], 0.F, 1e-5);
+  EXPECT_NEAR(mx[0], 0.5F, 1e-5);
+  EXPECT_NEAR(mn[1], -12.F, 1e-5);
+  EXPECT_NEAR(mx[1], -10.F, 1e-5);
+}
+
+// Poses of two frames 0.2 s apart in which the tractor drove 1 m and turned 10 degrees left (a headland turn):
+// the crown 15-17 m out swings 2.7 m to the right, far out of the gate.
+const FramePose kPose0{4'512'000.0, 5'430'000.0, 98.0, 30.0 * kDeg, 4};
+FramePose turned() {
+  FramePose p = kPose0;
+  p.x_m += std::cos(kPose0.yaw_rad);
+  p.y_m += std::sin(kPose0.yaw_rad);
+  p.yaw_rad += 10.0 * kDeg;
+  return p;
+}
+
+// Fragments of the box [min, max] (two returns at two corners, 0.1 m inside).
+std::vector<Fragment> fragments_in(const std::array<float, 3>& min, const std::array<float, 3>& max) {
+  return {fragment({min[0] + 0.1F, min[1] + 0.1F, min[2] + 0.5F}, {min[0] + 0.1F, min[1] + 0.1F, min[2] + 0.5F}, 1),
+          fragment({max[0] - 0.1F, max[1] - 0.1F, max[2] - 0.5F}, {max[0] - 0.1F, max[1] - 0.1F, max[2] - 0.5F}, 1)};
+}
+
+// With the frames' poses, what the hold remembers is moved into this frame: the crown's fragments where it now
+// stands are held, those where it stood are not. Without poses, the other way round.
+TEST(ObstacleHold, FollowsWhatItRemembersThroughTheFramePoses) {
+  std::array<float, 3> mn{}, mx{};
+  move_box(kCrown.min, kCrown.max, kPose0, turned(), mn, mx);
+  ASSERT_GT(std::hypot(centre(mn, mx)[0] - 16.F, centre(mn, mx)[1] - 8.F), 2.F) << "moved out of the gate";
+  for (const bool poses : {true, false}) {
+    const std::optional<FramePose> p0 = poses ? std::optional<FramePose>(kPose0) : std::nullopt;
+    const std::optional<FramePose> p1 = poses ? std::optional<FramePose>(turned()) : std::nullopt;
+    ObstacleHold hold(params());
+    FrameResult f0 = frame({kCrown});
+    (void)hold.apply(0, f0, std::nullopt, p0);
+    FrameResult now = frame({}, fragments_in(mn, mx));
+    EXPECT_EQ(hold.apply(2 * kPeriod, now, std::nullopt, p1), poses ? 1U : 0U)
+        << "where it stands now, poses " << poses;
+    ObstacleHold hold2(params());
+    FrameResult g0 = frame({kCrown});
+    (void)hold2.apply(0, g0, std::nullopt, p0);
+    FrameResult then = frame({}, fragments_in(kCrown.min, kCrown.max));
+    EXPECT_EQ(hold2.apply(2 * kPeriod, then, std::nullopt, p1), poses ? 0U : 1U) << "where it stood, poses " << poses;
+  }
+}
+
+// The filters' report of the same obstacle after the turn is the obstacle reported again: no fragment beside it
+// is held as a second one, though its old box is far from the new.
+TEST(ObstacleHold, ThroughThePosesTheMovedReportIsTheSameObstacle) {
+  Obstacle moved = kCrown;
+  move_box(kCrown.min, kCrown.max, kPose0, turned(), moved.min, moved.max);
+  // Shrunk back to the crown's size around the moved box's centre (the moved box of a box is larger).
+  const auto c = centre(moved.min, moved.max);
+  moved.min = {c[0] - 1.F, c[1] - 1.F, kCrown.min[2]};
+  moved.max = {c[0] + 1.F, c[1] + 1.F, kCrown.max[2]};
+  const std::vector<Fragment> beside{fragment({moved.max[0] + 0.1F, c[1], 1.F}, {moved.max[0] + 0.15F, c[1], 1.1F}, 2)};
+  for (const bool poses : {true, false}) {
+    ObstacleHold hold(params());
+    FrameResult f0 = frame({kCrown});
+    (void)hold.apply(0, f0, std::nullopt, poses ? std::optional<FramePose>(kPose0) : std::nullopt);
+    // Remembered anew from this report; the old box (out of place without poses) is what holds the fragment.
+    FrameResult f1 = frame({moved}, beside);
+    f1.fragments.push_back(fragment({kCrown.max[0] + 0.1F, 8.F, 1.F}, {kCrown.max[0] + 0.15F, 8.F, 1.1F}, 2));
+    EXPECT_EQ(hold.apply(kPeriod, f1, std::nullopt, poses ? std::optional<FramePose>(turned()) : std::nullopt),
+              poses ? 0U : 1U)
+        << "poses " << poses;
+  }
+}
+
+// A pose is used only when both frames have one, of the same plane, finite: otherwise the box stays where it was
+// reported (and the speed, when given, widens the gate).
+TEST(ObstacleHold, PosesOfAnotherPlaneOrNotFiniteOrMissingAreNotUsed) {
+  FramePose other = turned();
+  other.plane = 5;
+  FramePose nan = turned();
+  nan.yaw_rad = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    const char* what;
+    std::optional<FramePose> p0, p1;
+  };
+  const Case cases[] = {{"another plane", kPose0, other},
+                        {"not finite now", kPose0, nan},
+                        {"none then", std::nullopt, turned()},
+                        {"none now", kPose0, std::nullopt}};
+  for (const Case& k : cases) {
+    ObstacleHold hold(params());
+    FrameResult f0 = frame({kCrown});
+    (void)hold.apply(0, f0, std::nullopt, k.p0);
+    FrameResult then = frame({}, fragments_in(kCrown.min, kCrown.max));
+    EXPECT_EQ(hold.apply(2 * kPeriod, then, std::nullopt, k.p1), 1U) << k.what;
+  }
+  // A remembered pose with a non-finite one: not remembered as a pose.
+  ObstacleHold hold(params());
+  FrameResult f0 = frame({kCrown});
+  (void)hold.apply(0, f0, std::nullopt, nan);
+  FrameResult then = frame({}, fragments_in(kCrown.min, kCrown.max));
+  EXPECT_EQ(hold.apply(2 * kPeriod, then, std::nullopt, turned()), 1U) << "not finite then";
+}
+
 // A stamp before the last frame's (another capture, a clock step): everything remembered is forgotten.
 TEST(ObstacleHold, TimeGoingBackForgets) {
   ObstacleHold hold(params());

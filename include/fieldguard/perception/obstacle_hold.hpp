@@ -7,8 +7,11 @@
 // no box of this frame are reported as one obstacle, when they hold min_points points together.
 //
 // Only the filters' obstacles are remembered: a held obstacle holds nothing, so an obstacle the filters have
-// not reported for max_age_s is let go whatever its fragments. Boxes are compared in the sensor frame: the
-// tractor's travel since the report must fit in the gate, which grows along x with it when the speed is given.
+// not reported for max_age_s is let go whatever its fragments. Boxes are compared in the frame of this frame's
+// boxes: given each frame's pose (FramePose: a fused, levelled frame's place and heading), a remembered box is
+// moved into this frame first (its corners, then their box), so that the tractor's travel and turning since the
+// report need not fit in the gate; without poses the travel must fit, and the gate grows along x with it when the
+// speed is given.
 //
 // Stateful across frames, so it runs where the frames are in order (replay's and the daemon's delivery), not in
 // the workers' Pipeline. Thread-compatible.
@@ -23,6 +26,23 @@
 
 namespace fieldguard::perception {
 
+// Where a frame's boxes stand: its origin in a fixed, horizontal plane (metres) and the angle of its x axis
+// from the plane's first axis, counter-clockwise (radians), for a frame whose z axis is vertical (levelled).
+// `plane` names the plane (a map zone): poses in different planes are not compared.
+struct FramePose {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double z_m = 0.0;
+  double yaw_rad = 0.0;
+  int plane = 0;
+};
+
+// The box [min, max] of a frame posed `from` as it stands in a frame posed `to`: in x and y the box around its
+// four corners moved, in z the box moved by the difference in the origins' heights. The poses must be of the
+// same plane.
+void move_box(const std::array<float, 3>& min, const std::array<float, 3>& max, const FramePose& from,
+              const FramePose& to, std::array<float, 3>& out_min, std::array<float, 3>& out_max);
+
 class ObstacleHold {
  public:
   // Throws std::invalid_argument for a negative or non-finite max_age_s or gate_m, or min_points < 1.
@@ -33,8 +53,11 @@ class ObstacleHold {
   // how many. A stamp before the last frame's forgets every obstacle (a new capture, or the clock stepped).
   // `speed_mps`, when known (the tractor's, from the bus): a remembered obstacle's gate grows along x by the
   // distance driven since its report, forwards and backwards alike (the speed has no sign). A negative or
-  // non-finite speed counts as unknown. Disabled: does nothing.
-  std::size_t apply(std::int64_t stamp_ns, FrameResult& result, std::optional<double> speed_mps = std::nullopt);
+  // non-finite speed counts as unknown. `pose`, when known (a value not finite counts as unknown): where this
+  // frame's boxes stand; an obstacle remembered with a pose of the same plane is moved into this frame, and
+  // the speed is not used for it. Disabled: does nothing.
+  std::size_t apply(std::int64_t stamp_ns, FrameResult& result, std::optional<double> speed_mps = std::nullopt,
+                    const std::optional<FramePose>& pose = std::nullopt);
 
   // The obstacles remembered (for tests).
   [[nodiscard]] std::size_t remembered() const { return seen_.size(); }
@@ -43,7 +66,8 @@ class ObstacleHold {
   struct Seen {
     std::array<float, 3> min;
     std::array<float, 3> max;
-    std::int64_t stamp_ns;  // of the frame whose filters last reported it
+    std::int64_t stamp_ns;          // of the frame whose filters last reported it
+    std::optional<FramePose> pose;  // of that frame, when known
   };
   HoldParams params_;
   std::int64_t max_age_ns_ = 0;
