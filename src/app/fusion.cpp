@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <utility>
 #include <variant>
@@ -51,6 +52,19 @@ sync::SyncParams sync_params(const Config& cfg, const FusionInputs& in) {
 }  // namespace
 
 // ---- FrameDetector ------------------------------------------------------------------------------------
+
+std::optional<perception::FramePose> detection_pose(const FusionInfo& f, const Mounting& lidar) {
+  if (f.levelling != geo::Levelling::Full || !f.reference || !f.attitude) return std::nullopt;
+  const double yaw = f.attitude->yaw_deg * (std::numbers::pi / 180.0);
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  perception::FramePose p;
+  p.x_m = f.reference->easting_m + c * lidar.x_m - s * lidar.y_m;
+  p.y_m = f.reference->northing_m + s * lidar.x_m + c * lidar.y_m;
+  p.z_m = f.reference->up_m + lidar.z_m;
+  p.yaw_rad = yaw;
+  p.plane = f.reference->zone;
+  return p;
+}
 
 FrameDetector::FrameDetector(const Config& cfg) : pipeline_(cfg.perception), compensator_(compensation_params(cfg)) {}
 

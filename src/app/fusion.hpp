@@ -28,6 +28,7 @@
 #include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/output/plausibility.hpp"
 #include "fieldguard/perception/obstacle.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/sync/synced_frame.hpp"
 
@@ -73,6 +74,12 @@ struct FusionInfo {
   std::uint32_t rotations = 0;
   std::uint32_t scan_points = 0;  // lifted 2D points in the frame
 };
+
+// Where a fused frame's boxes stand, for the hold (perception::FramePose): the detection frame's origin in the
+// plane and its heading, p_plane = reference + Rz(yaw) (p_detect + the LiDAR's mounting position), in the
+// reference's zone. Only for a frame levelled in full (position and attitude: the frame's z is vertical and
+// its place known); nothing otherwise.
+[[nodiscard]] std::optional<perception::FramePose> detection_pose(const FusionInfo& f, const Mounting& lidar);
 
 struct DetectedFrame {
   // The points detection ran on: the rotation, or the compensated fused frame (index: the frame's sequence

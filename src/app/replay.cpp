@@ -388,7 +388,10 @@ int cmd_replay(const std::vector<std::string>& argv) {
     }
     if (!detect) return;
     perception::FrameResult& result = r.output->det.result;
-    hold.apply(f.host_stamp.ns, result);
+    // A fused frame levelled in full gives its pose: the hold moves what it remembers by the travel and turning.
+    const std::optional<perception::FramePose> pose =
+        fused != nullptr ? detection_pose(*fused, cfg.lidar.mounting) : std::nullopt;
+    hold.apply(f.host_stamp.ns, result, std::nullopt, pose);
     held_total += result.counts.held;
     if (result.counts.held > 0 && r.output->bev) {
       held.clear();

@@ -402,9 +402,13 @@ class Session {
     worst_us_ = std::max(worst_us_, t.total_us);
     ++timed_count_;
     // Frame to frame, so here in frame order (obstacle_hold.hpp); a rotation lost in between only ages what it
-    // remembers. The tractor's speed from the bus, when known, widens its gate by the distance driven.
+    // remembers. A fused frame levelled in full gives its pose, and what the hold remembers is moved by the
+    // travel and turning since; otherwise the tractor's speed from the bus, when known, widens its gate by the
+    // distance driven.
     const Stamp now = wall_clock_now();
-    held_ += hold_.apply(r.output->frame.host_stamp.ns, r.output->result, stage_.speed_at(now));
+    const std::optional<perception::FramePose> pose =
+        r.output->fusion ? detection_pose(*r.output->fusion, cfg_.lidar.mounting) : std::nullopt;
+    held_ += hold_.apply(r.output->frame.host_stamp.ns, r.output->result, stage_.speed_at(now), pose);
     stage_.frame(r.output->frame, r.output->result, r.input->complete, now, lost_);
     if (ready_) notify_.progress(SteadyClock::now());
   }
