@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 namespace fieldguard::app {
 namespace {
@@ -70,24 +71,18 @@ void fusion_json(std::string& s, const FusionInfo& f) {
   s += '}';
 }
 
-// The level frame is the plane frame turned by the heading and moved to the reference point
-// (geo/deskew.hpp): p_plane = P_ref + Rz(yaw) p_level, and p_level = p_detect + the LiDAR's mounting.
-void plane_json(std::string& s, const perception::Obstacle& o, const FusionInfo& f, const Mounting& lidar) {
-  const double x = 0.5 * (static_cast<double>(o.min[0]) + static_cast<double>(o.max[0])) + lidar.x_m;
-  const double y = 0.5 * (static_cast<double>(o.min[1]) + static_cast<double>(o.max[1])) + lidar.y_m;
-  const double z = static_cast<double>(o.min[2]) + lidar.z_m;
-  const double yaw = f.attitude->yaw_deg * (3.14159265358979323846 / 180.0);
-  const double c = std::cos(yaw);
-  const double sn = std::sin(yaw);
-  const double e = f.reference->easting_m + c * x - sn * y;
-  const double n = f.reference->northing_m + sn * x + c * y;
-  const double u = f.reference->up_m + z;
+// The detection frame's pose on the plane (detection_pose): p_plane = origin + Rz(yaw) p_detect.
+void plane_json(std::string& s, const perception::Obstacle& o, const perception::FramePose& pose) {
+  const double x = 0.5 * (static_cast<double>(o.min[0]) + static_cast<double>(o.max[0]));
+  const double y = 0.5 * (static_cast<double>(o.min[1]) + static_cast<double>(o.max[1]));
+  const double c = std::cos(pose.yaw_rad);
+  const double sn = std::sin(pose.yaw_rad);
   s += ",\"plane\":[";
-  num(s, e, 3);
+  num(s, pose.x_m + c * x - sn * y, 3);
   s += ',';
-  num(s, n, 3);
+  num(s, pose.y_m + sn * x + c * y, 3);
   s += ',';
-  num(s, u, 3);
+  num(s, pose.z_m + static_cast<double>(o.min[2]), 3);
   s += ']';
 }
 
@@ -101,7 +96,8 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
   s += frame.partial ? "true" : "false";
   s += ",\"points_in\":" + std::to_string(frame.points.size());
   if (fusion != nullptr) fusion_json(s, *fusion);
-  const bool plane = fusion != nullptr && lidar != nullptr && fusion->reference && fusion->attitude;
+  const std::optional<perception::FramePose> pose =
+      fusion != nullptr && lidar != nullptr ? detection_pose(*fusion, *lidar) : std::nullopt;
   s += ",\"obstacles\":[";
   bool first = true;
   for (const auto& o : result.obstacles) {
@@ -132,7 +128,7 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
     if ((o.sources & perception::kSeenBy2d) != 0) s += (o.sources & perception::kSeenBy3d) != 0 ? ",\"seen_by\":\"3d+2d\"" : ",\"seen_by\":\"2d\"";
     // Only where the hold reported it (obstacle_hold.hpp): the filters' obstacles keep their bytes.
     if (o.held) s += ",\"held\":true";
-    if (plane) plane_json(s, o, *fusion, *lidar);
+    if (pose) plane_json(s, o, *pose);
     s += '}';
   }
   s += "]}";
