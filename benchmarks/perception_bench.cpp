@@ -46,7 +46,7 @@
 #include <string>
 #include <vector>
 
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/config/config.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/perception/cluster_absorb.hpp"
 #include "fieldguard/perception/cluster_join.hpp"

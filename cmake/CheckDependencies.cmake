@@ -1,12 +1,22 @@
 # Fails when a module includes a header of a module to its right in the chain
-#   core <- drivers <- io <- perception <- app   (sync, geo, output slot in as they arrive).
+#   core <- drivers <- io <- sync <- geo, perception <- output <- config <- engine <- writers, inspect
+#        <- replay, daemon <- app
+# (a module may include what is to its left), or a private header (src/<other>/...) of another module.
 # Run as: cmake -DROOT=<source dir> -P CheckDependencies.cmake
-set(order core drivers io sync geo perception output app)
+set(order core drivers io sync geo perception output config engine writers inspect replay daemon app)
 set(bad 0)
 foreach(mod IN LISTS order)
   list(FIND order ${mod} pos)
   file(GLOB_RECURSE files ${ROOT}/include/fieldguard/${mod}/*.hpp ${ROOT}/src/${mod}/*.cpp ${ROOT}/src/${mod}/*.hpp)
   foreach(f IN LISTS files)
+    file(STRINGS ${f} private REGEX "#include \"[a-z_]+/")
+    foreach(l IN LISTS private)
+      string(REGEX MATCH "#include \"([a-z_]+)/" _ "${l}")
+      if(NOT CMAKE_MATCH_1 STREQUAL mod AND NOT CMAKE_MATCH_1 STREQUAL "fieldguard")
+        message(SEND_ERROR "${f}: includes a private header of module '${CMAKE_MATCH_1}' (${l}): only its include/fieldguard/${CMAKE_MATCH_1}/ headers are public")
+        set(bad 1)
+      endif()
+    endforeach()
     file(STRINGS ${f} lines REGEX "#include \"fieldguard/[a-z_]+/")
     foreach(l IN LISTS lines)
       string(REGEX MATCH "fieldguard/([a-z_]+)/" _ "${l}")

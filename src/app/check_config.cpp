@@ -2,7 +2,8 @@
 
 #include "app/args.hpp"
 #include "app/commands.hpp"
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/core/exit_code.hpp"
+#include "fieldguard/config/config.hpp"
 
 namespace fieldguard::app {
 

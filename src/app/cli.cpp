@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "app/commands.hpp"
+#include "fieldguard/core/exit_code.hpp"
 #include "fieldguard/core/version.hpp"
 
 namespace fieldguard::app {

@@ -1,6 +1,6 @@
 // The bird's-eye picture's obstacle boxes: the filters' in red (small) or orange (large), the hold's
 // (obstacle_hold.hpp) in cyan and labelled "held", drawn by render_bev or afterwards by draw_obstacles.
-#include "app/bev.hpp"
+#include "fieldguard/writers/bev.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "app/config_issues.hpp"
-#include "app/fusion.hpp"
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/engine/fusion.hpp"
+#include "fieldguard/config/config.hpp"
 
 namespace fieldguard::app {
 namespace {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <string>
 
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/config/config.hpp"
 
 namespace fieldguard::app::testing {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "app/config_issues.hpp"
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/config/config.hpp"
 
 namespace fieldguard::app {
 namespace {

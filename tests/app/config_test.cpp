@@ -1,5 +1,5 @@
 #include "app/config_issues.hpp"
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/config/config.hpp"
 
 #include <gtest/gtest.h>
 

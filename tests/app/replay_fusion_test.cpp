@@ -24,14 +24,14 @@
 #include <string>
 #include <vector>
 
-#include "app/fusion.hpp"
-#include "app/obstacles_jsonl.hpp"
+#include "fieldguard/engine/fusion.hpp"
+#include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "app/json_reader.hpp"
-#include "app/recording.hpp"
+#include "replay/recording.hpp"
 #include "app/run_command.hpp"
 #include "app/sim_can_support.hpp"
 #include "support/shared_output.hpp"
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/config/config.hpp"
 #include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/drivers/velodyne_decoder.hpp"
 #include "fieldguard/geo/projection.hpp"

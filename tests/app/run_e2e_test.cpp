@@ -30,7 +30,7 @@
 
 #include "app/json_reader.hpp"
 #include "app/sim_can_support.hpp"
-#include "fieldguard/app/config.hpp"
+#include "fieldguard/config/config.hpp"
 #include "fieldguard/output/safety_params.hpp"
 #include "io/pcap_builder.hpp"
 #include "output/dbc_reader.hpp"

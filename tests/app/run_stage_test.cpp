@@ -1,5 +1,5 @@
 // The daemon's output stage on a fake clock: decisions between rotations reach the bus at once.
-#include "app/run_stage.hpp"
+#include "daemon/run_stage.hpp"
 #include "fieldguard/output/safety_params.hpp"
 
 #include <gtest/gtest.h>

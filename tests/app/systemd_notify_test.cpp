@@ -1,6 +1,6 @@
 // SystemdNotifier against a real AF_UNIX datagram socket standing where systemd's notify socket would be
 // (NOTIFY_SOCKET), reading exactly what libsystemd's sd_pid_notify sends.
-#include "app/systemd_notify.hpp"
+#include "daemon/systemd_notify.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,202 @@
+#pragma once
+// The one path from sensor data to detected frames that replay and the daemon share.
+//
+// SensorFusion (the io side, one thread): the sensors' bytes and packets in, with their receive times,
+// FrameJobs out. Two modes, chosen once from which sensors feed it:
+//   rotations  the 3D LiDAR alone: every rotation is a frame, its points in the LiDAR's own frame;
+//   fused      a 2D LiDAR, GNSS or AHRS as well: sync::Synchronizer maps every sensor's clock onto the host
+//              clock and cuts frames of whole rotations at sync.rate_hz with the 2D scan nearest in time and
+//              the GNSS and AHRS samples around the window.
+// FrameDetector (a worker's): a FrameJob in, a DetectedFrame out. A fused frame is first made into the levelled
+// detection frame by geo::FrameCompensator (its own GNSS/AHRS samples only, so the result does not depend on
+// which worker runs it or when), then perception runs on it.
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fieldguard/config/config.hpp"
+#include "fieldguard/core/bytes.hpp"
+#include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/core/time.hpp"
+#include "fieldguard/drivers/nmea.hpp"
+#include "fieldguard/drivers/scip_data.hpp"
+#include "fieldguard/drivers/xsens_mtdata2.hpp"
+#include "fieldguard/geo/frame_compensator.hpp"
+#include "fieldguard/output/plausibility.hpp"
+#include "fieldguard/perception/obstacle.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
+#include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/sync/synced_frame.hpp"
+
+namespace fieldguard::velodyne {
+class Stream;
+}
+namespace fieldguard::sync {
+class Synchronizer;
+}
+
+namespace fieldguard::app {
+
+// The sensors that feed frames besides the 3D LiDAR.
+struct FusionInputs {
+  bool scan2d = false;
+  bool gnss = false;
+  bool ahrs = false;
+  [[nodiscard]] bool any() const { return scan2d || gnss || ahrs; }
+  // Live: the sensors the configuration enables.
+  [[nodiscard]] static FusionInputs enabled_in(const Config& cfg) {
+    return {cfg.scan2d.enabled, cfg.gnss.serial.enabled, cfg.ahrs.serial.enabled};
+  }
+};
+
+// sync::SyncParams and geo::CompensationParams as the configuration gives them.
+[[nodiscard]] geo::CompensationParams compensation_params(const Config& cfg);
+
+// A frame on its way to a worker.
+struct FrameJob {
+  LidarFrame rotation;                      // rotations mode
+  std::optional<sync::SyncedFrame> synced;  // fused mode
+  Stamp complete;  // host time at which the frame was whole: its last data in hand (or its timeout)
+};
+
+// What the outputs need of the compensation.
+struct FusionInfo {
+  geo::Levelling levelling = geo::Levelling::None;
+  std::optional<geo::PlaneCoord> reference;  // vehicle reference point at the frame's reference instant
+  std::optional<geo::EulerDeg> attitude;
+  geo::CompensationStats stats;
+  std::uint8_t missing = 0;  // sync::bit() of the sensors the frame lacks
+  bool timed_out = false;
+  std::uint32_t rotations = 0;
+  std::uint32_t scan_points = 0;  // lifted 2D points in the frame
+};
+
+// Where a fused frame's boxes stand, for the hold (perception::FramePose): the detection frame's origin in the
+// plane and its heading, p_plane = reference + Rz(yaw) (p_detect + the LiDAR's mounting position), in the
+// reference's zone. Only for a frame levelled in full (position and attitude: the frame's z is vertical and
+// its place known); nothing otherwise.
+[[nodiscard]] std::optional<perception::FramePose> detection_pose(const FusionInfo& f, const Mounting& lidar);
+
+struct DetectedFrame {
+  // The points detection ran on: the rotation, or the compensated fused frame (index: the frame's sequence
+  // number, host_stamp: its window's start, partial: a partial window or a frame that lacks a sensor).
+  LidarFrame frame;
+  perception::FrameResult result;
+  std::optional<FusionInfo> fusion;  // fused mode
+};
+
+class FrameDetector {
+ public:
+  explicit FrameDetector(const Config& cfg);
+  // Consumes the job's points (moved into the result). detect = false: compensation only (points to write).
+  [[nodiscard]] DetectedFrame process(FrameJob& job, bool detect = true);
+  [[nodiscard]] const perception::Pipeline& pipeline() const { return pipeline_; }
+
+ private:
+  perception::Pipeline pipeline_;
+  geo::FrameCompensator compensator_;
+  geo::CompensatedFrame scratch_;
+};
+
+// A FrameDetector keeps scratch buffers between frames and is not thread-safe: each worker borrows one for the
+// length of a frame. There are as many as workers, so a worker never finds the set empty.
+class DetectorSet {
+ public:
+  DetectorSet(const Config& cfg, std::size_t n);
+  class Lease {
+   public:
+    explicit Lease(DetectorSet& set);
+    ~Lease();
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    Lease(Lease&&) = delete;
+    Lease& operator=(Lease&&) = delete;
+    FrameDetector& operator*() const { return *d_; }
+    FrameDetector* operator->() const { return d_.get(); }
+
+   private:
+    DetectorSet& set_;
+    std::unique_ptr<FrameDetector> d_;
+  };
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<FrameDetector>> free_;
+};
+
+struct FusionCounts {
+  std::uint64_t frames = 0;        // jobs handed out
+  std::uint64_t scans = 0;         // 2D scans decoded
+  std::uint64_t gnss = 0;          // NMEA sentences decoded
+  std::uint64_t ahrs = 0;          // MTData2 messages decoded
+  std::uint64_t scan_errors = 0;   // SCIP framing or decoding errors
+  std::uint64_t gnss_errors = 0;   // NMEA sentences rejected
+  std::uint64_t ahrs_errors = 0;   // Xsens messages rejected
+};
+
+class SensorFusion {
+ public:
+  SensorFusion(const Config& cfg, FusionInputs inputs);
+  ~SensorFusion();
+  SensorFusion(const SensorFusion&) = delete;
+  SensorFusion& operator=(const SensorFusion&) = delete;
+
+  [[nodiscard]] bool fused() const { return inputs_.any(); }
+
+  // A 3D LiDAR data packet (kDataPacketSize bytes) received at `host`.
+  void lidar(ByteSpan payload, Stamp host, std::vector<FrameJob>& out);
+  // The 2D LiDAR's conversation as a byte log holds it (to_sensor: what the client sent; a new connection
+  // starts with SCIP2.0) ...
+  void scan2d_bytes(ByteSpan bytes, bool to_sensor, Stamp host, std::vector<FrameJob>& out);
+  // ... or a scan a live scip source has already decoded.
+  void scan(const scip::Scan& s, Stamp host, std::vector<FrameJob>& out);
+  void gnss(ByteSpan bytes, Stamp host, std::vector<FrameJob>& out);
+  void ahrs(ByteSpan bytes, Stamp host, std::vector<FrameJob>& out);
+  // Frames whose timeout has passed at host time `now` (fused mode; nothing in rotations mode).
+  void poll(Stamp now, std::vector<FrameJob>& out);
+  // End of input: the rotation still open and every waiting window go out.
+  void finish(Stamp now, std::vector<FrameJob>& out);
+
+  [[nodiscard]] const velodyne::Stream& stream() const { return *stream_; }
+  [[nodiscard]] const sync::Synchronizer* synchronizer() const { return sync_.get(); }
+  [[nodiscard]] const FusionCounts& counts() const { return counts_; }
+
+  // Plausibility of the GNSS fixes (GGA) and AHRS attitudes (MTData2 Euler angles) decoded so far, for the
+  // safety monitor (`safety.gnss`, `safety.ahrs` limits), checked in every mode.
+  struct Problems {
+    output::safety::Problem gnss = output::safety::Problem::None;  // first since the previous take
+    output::safety::Problem ahrs = output::safety::Problem::None;
+    Stamp gnss_at;  // receive time of the sample that showed it
+    Stamp ahrs_at;
+  };
+  [[nodiscard]] Problems take_problems();
+  [[nodiscard]] std::string status(Stamp now) const;
+
+ private:
+  struct Decoders;
+  void rotations_to(Stamp host, std::vector<FrameJob>& out);
+  void frames_to(Stamp host, std::vector<FrameJob>& out);     // poll sync, then jobs_from_frames
+  void jobs_from_frames(Stamp host, std::vector<FrameJob>& out);  // frames_ out as jobs complete at `host`
+  void pass_sentences(Stamp host);  // decoded NMEA: counted, checked, to sync
+  void pass_items(Stamp host);      // decoded MTData2: likewise
+
+  void check(const nmea::Sentence& s, Stamp host);
+  void check(const xsens::MtData2& m, Stamp host);
+
+  FusionInputs inputs_;
+  output::safety::GnssCheck gnss_check_;
+  output::safety::AhrsCheck ahrs_check_;
+  Problems problems_;
+  std::unique_ptr<velodyne::Stream> stream_;
+  std::unique_ptr<sync::Synchronizer> sync_;
+  std::unique_ptr<Decoders> dec_;
+  std::vector<LidarFrame> rotations_;
+  std::vector<sync::SyncedFrame> frames_;
+  FusionCounts counts_;
+};
+
+}  // namespace fieldguard::app

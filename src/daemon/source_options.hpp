@@ -1,0 +1,38 @@
+#pragma once
+// The live sources' options from the sensor sections of the configuration: `record` and `run` open the same
+// 2D LiDAR connection and GNSS / AHRS ports the same way.
+
+#include <cstdint>
+
+#include "fieldguard/config/config.hpp"
+#include "fieldguard/io/scip_source.hpp"
+#include "fieldguard/io/serial_reader.hpp"
+
+namespace fieldguard::app {
+
+[[nodiscard]] inline io::SerialOptions serial_options(const SerialConfig& c) {
+  io::SerialOptions o;
+  o.device = c.device;
+  o.baud = c.baud;
+  o.data_bits = c.data_bits;
+  o.parity = c.parity;
+  o.stop_bits = c.stop_bits;
+  o.silence_timeout_s = c.silence_timeout_s;
+  o.reopen_interval_s = c.reopen_interval_s;
+  return o;
+}
+
+[[nodiscard]] inline io::ScipSourceOptions scip_source_options(const Scan2dConfig& c) {
+  io::ScipSourceOptions o;
+  o.tcp.host = c.host;
+  o.tcp.port = c.port;
+  o.tcp.connect_timeout_s = c.connect_timeout_s;
+  o.tcp.silence_timeout_s = c.silence_timeout_s;
+  o.tcp.backoff_max_s = c.backoff_max_s;
+  o.client.scan.first_step = static_cast<std::uint16_t>(c.start_step);
+  o.client.scan.last_step = static_cast<std::uint16_t>(c.end_step);
+  o.client.intensity = c.intensity;
+  return o;
+}
+
+}  // namespace fieldguard::app
