@@ -151,55 +151,133 @@ struct Processed {
 
 using Pool = sync::OrderedPool<FrameJob, Processed>;
 
-}  // namespace
+// Implausible GNSS / AHRS samples, by receive time: each goes to the first decision at or after it.
+struct TimedProblem {
+  Stamp at;
+  output::safety::Sensor sensor;
+  output::safety::Problem problem;
+};
 
-int replay(const ReplayOptions& opt) {
-  const auto log = logger("replay");
-  const auto started = std::chrono::steady_clock::now();
+// One replay, in three steps: open() the inputs and outputs, read() every record through the frame path (frames
+// are processed by the pool's workers and delivered here in frame order, where everything is written), then
+// finish(): the summary and the exit code. Thread-compatible; its pool's workers call process() only.
+class Replay {
+ public:
+  Replay(const ReplayOptions& opt, const Config& cfg, std::size_t workers)
+      : opt_(opt), cfg_(cfg), workers_(workers), hold_(cfg.perception.hold) {}
 
-  const auto loaded = load_config_file(opt.config);
-  if (!loaded.ok()) {
-    for (const auto& issue : loaded.issues) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
-    std::fprintf(stderr, "fieldguard replay: invalid configuration %s\n", opt.config.c_str());
-    return kExitBadInput;
+  // The session, the capture, the byte logs and every output the options ask for. False (with the message
+  // printed) when one cannot be opened.
+  bool open();
+  // Every record of the capture and the logs, merged by receive time, then the last frames and the pool drained.
+  void read();
+  // The summary on stdout and warnings on the log; the process exit code.
+  int finish();
+
+ private:
+  bool open_outputs();
+  Processed process(FrameJob& job);
+  void deliver(const Pool::Result& r);
+  void write_frame(const Pool::Result& r);
+  void decide(const Pool::Result& r, const LidarFrame& f, perception::FrameResult& result);
+  void submit_jobs();
+  void on_datagram(const io::UdpDatagram& dg);
+  void on_record(LogKind kind, const io::ByteLogRecord& rec);
+  void progress_line();
+  void print_fusion_summary() const;
+  std::string can_log_error() const {
+    return "cannot write " + *opt_.can_log + ": " + std::strerror(can_log_->stats().last_errno);
   }
-  const Config& cfg = loaded.config;
-  const std::size_t workers = opt.workers.value_or(static_cast<std::size_t>(cfg.pipeline.workers));
 
-  const std::string session_dir = opt.session.value_or("");
+  const ReplayOptions& opt_;
+  const Config& cfg_;
+  const std::size_t workers_;
+  const std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  std::shared_ptr<spdlog::logger> log_ = logger("replay");
+
+  // Inputs.
+  std::string pcap_path_;
+  std::vector<LogFile> logs_;
+  std::optional<RecordingReader> recording_;
+  std::optional<SensorFusion> fusion_;
+  // Outputs.
+  std::ofstream samples_file_;
+  std::optional<SampleDecoder> samples_;
+  std::string pcd_dir_;
+  std::string bev_dir_;
+  std::ofstream obstacles_out_;
+  std::optional<output::CandumpLogSink> can_log_;
+  std::optional<CanStage> can_;
+  bool detect_ = false;  // the detection pipeline runs (an output needs its result)
+  // The frame path.
+  std::optional<DetectorSet> detectors_;
+  std::optional<Pool> pool_;
+  std::vector<FrameJob> jobs_;
+  perception::ObstacleHold hold_;  // frame to frame, so here in frame order and not in the workers
+  std::vector<perception::Obstacle> held_;  // one frame's held obstacles, for its picture
+  std::array<HeardTimes, 3> heard_;  // scan2d, gnss, ahrs: LogKind order
+  std::deque<TimedProblem> problems_;
+  // Counts for the summary.
+  PositionCounters pos_;
+  PortCounters ports_;
+  std::uint64_t obstacles_total_ = 0;
+  std::uint64_t held_total_ = 0;
+  std::vector<perception::StageTimes> times_;  // each frame's
+  std::uint64_t written_ = 0;
+  std::uint64_t lost_ = 0;
+  std::string write_error_;
+  Stamp first_time_;
+  Stamp last_time_;
+  bool progress_ = false;
+  std::chrono::steady_clock::time_point last_progress_ = started_;
+};
+
+bool Replay::open() {
+  const std::string session_dir = opt_.session.value_or("");
   if (!session_dir.empty() && !fs::is_directory(session_dir)) {
     std::fprintf(stderr, "fieldguard replay: %s is not a directory written by `fieldguard record`\n", session_dir.c_str());
-    return kExitBadInput;
+    return false;
   }
-  const std::string pcap_path = session_dir.empty() ? *opt.pcap : (fs::path(session_dir) / "lidar.pcap").string();
-  std::ofstream samples_file;
-  if (const auto& s = opt.samples_out) {
-    samples_file.open(*s, std::ios::trunc);
-    if (!samples_file) {
+  pcap_path_ = session_dir.empty() ? *opt_.pcap : (fs::path(session_dir) / "lidar.pcap").string();
+  if (const auto& s = opt_.samples_out) {
+    samples_file_.open(*s, std::ios::trunc);
+    if (!samples_file_) {
       std::fprintf(stderr, "fieldguard replay: cannot write %s\n", s->c_str());
-      return kExitBadInput;
+      return false;
     }
   }
-  std::vector<LogFile> logs;
   const std::tuple<const char*, LogKind, const std::optional<std::string>&> kLogNames[] = {
-      {"scan2d", LogKind::Scan2d, opt.scan2d_log}, {"gnss", LogKind::Gnss, opt.gnss_log},
-      {"ahrs", LogKind::Ahrs, opt.ahrs_log}};
+      {"scan2d", LogKind::Scan2d, opt_.scan2d_log}, {"gnss", LogKind::Gnss, opt_.gnss_log},
+      {"ahrs", LogKind::Ahrs, opt_.ahrs_log}};
   for (const auto& [name, kind, given] : kLogNames) {
     if (given) {
-      logs.push_back({*given, kind});
+      logs_.push_back({*given, kind});
     } else if (!session_dir.empty() && fs::exists(fs::path(session_dir) / (std::string(name) + ".log"))) {
-      logs.push_back({(fs::path(session_dir) / (std::string(name) + ".log")).string(), kind});
+      logs_.push_back({(fs::path(session_dir) / (std::string(name) + ".log")).string(), kind});
     }
   }
-  std::optional<SampleDecoder> samples;
-  if (samples_file.is_open()) samples.emplace(cfg, &samples_file);
-  auto recording = RecordingReader::open(pcap_path, logs);
+  if (samples_file_.is_open()) samples_.emplace(cfg_, &samples_file_);
+  auto recording = RecordingReader::open(pcap_path_, logs_);
   if (!recording) {
     std::fprintf(stderr, "fieldguard replay: %s\n", recording.error().c_str());
-    return kExitBadInput;
+    return false;
   }
-  const FusionInputs inputs{recording->has(LogKind::Scan2d), recording->has(LogKind::Gnss), recording->has(LogKind::Ahrs)};
+  recording_.emplace(std::move(recording).value());
+  if (!open_outputs()) return false;
+  fusion_.emplace(cfg_, FusionInputs{recording_->has(LogKind::Scan2d), recording_->has(LogKind::Gnss),
+                                     recording_->has(LogKind::Ahrs)});
+  detect_ = obstacles_out_.is_open() || !bev_dir_.empty() || can_.has_value();
+  // A fused frame needs the compensation even when only its points are written.
+  if (detect_ || fusion_->fused()) detectors_.emplace(cfg_, workers_);
+  sync::PoolParams pool_params;
+  pool_params.workers = workers_;
+  pool_params.queue_capacity = static_cast<std::size_t>(cfg_.pipeline.queue_capacity);
+  pool_.emplace(pool_params, [this](FrameJob& job) { return process(job); });
+  progress_ = !opt_.quiet && isatty(STDERR_FILENO) != 0;
+  return true;
+}
 
+bool Replay::open_outputs() {
   auto make_dir = [](const std::string& option, const std::string& dir) {
     std::error_code ec;
     fs::create_directories(dir, ec);
@@ -210,257 +288,219 @@ int replay(const ReplayOptions& opt) {
     }
     return true;
   };
-  const std::string pcd_dir = opt.pcd_dir.value_or("");
-  const std::string bev_dir = opt.bev_dir.value_or("");
-  if (!pcd_dir.empty() && !make_dir("PCD", pcd_dir)) return kExitBadInput;
-  if (!bev_dir.empty() && !make_dir("bird's-eye", bev_dir)) return kExitBadInput;
-  std::ofstream obstacles_out;
-  if (const auto& o = opt.obstacles_out) {
-    obstacles_out.open(*o, std::ios::binary | std::ios::trunc);
-    if (!obstacles_out) {
+  pcd_dir_ = opt_.pcd_dir.value_or("");
+  bev_dir_ = opt_.bev_dir.value_or("");
+  if (!pcd_dir_.empty() && !make_dir("PCD", pcd_dir_)) return false;
+  if (!bev_dir_.empty() && !make_dir("bird's-eye", bev_dir_)) return false;
+  if (const auto& o = opt_.obstacles_out) {
+    obstacles_out_.open(*o, std::ios::binary | std::ios::trunc);
+    if (!obstacles_out_) {
       std::fprintf(stderr, "fieldguard replay: cannot write %s\n", o->c_str());
-      return kExitBadInput;
+      return false;
     }
   }
-  std::optional<output::CandumpLogSink> can_log;
-  std::optional<CanStage> can;
-  if (const auto& c = opt.can_log) {
+  if (const auto& c = opt_.can_log) {
     try {
-      can_log.emplace(*c, cfg.can.interface);
-      can.emplace(cfg, *can_log);
+      can_log_.emplace(*c, cfg_.can.interface);
+      can_.emplace(cfg_, *can_log_);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "fieldguard replay: --can-log: %s\n", e.what());
-      return kExitBadInput;
+      return false;
     }
   }
-  auto can_log_error = [&] {
-    return "cannot write " + *opt.can_log + ": " + std::strerror(can_log->stats().last_errno);
-  };
-  SensorFusion fusion(cfg, inputs);
-  const bool detect = obstacles_out.is_open() || !bev_dir.empty() || can.has_value();
-  // A fused frame needs the compensation even when only its points are written.
-  std::optional<DetectorSet> detectors;
-  if (detect || fusion.fused()) detectors.emplace(cfg, workers);
-  std::uint64_t obstacles_total = 0;
-  std::vector<perception::StageTimes> times;  // each frame's, for the summary
-  std::array<HeardTimes, 3> heard;  // scan2d, gnss, ahrs: LogKind order
-  // Implausible GNSS / AHRS samples, by receive time: each goes to the first decision at or after it.
-  struct TimedProblem {
-    Stamp at;
-    output::safety::Sensor sensor;
-    output::safety::Problem problem;
-  };
-  std::deque<TimedProblem> problems;
-  const output::safety::Sensor kHeardSensor[] = {output::safety::Sensor::Scan2d, output::safety::Sensor::Gnss,
-                                                 output::safety::Sensor::Ahrs};
+  return true;
+}
 
-  PositionCounters pos;
-  PortCounters ports;
-  std::vector<FrameJob> jobs;
-  std::uint64_t written = 0;
-  std::uint64_t lost = 0;
-  std::string write_error;
-  Stamp first_time;
-  Stamp last_time;
-  const bool progress = !opt.quiet && isatty(STDERR_FILENO) != 0;
-  auto last_progress = started;
-
-  // Workers: compensation, perception (and the bird's-eye picture, which needs the worker's pipeline). Everything
-  // that is written happens in deliver(), on this thread, in frame order: the output does not depend on the count.
-  auto process = [&](FrameJob& job) {
-    Processed out;
-    if (!detectors) {
-      out.det.frame = std::move(job.rotation);
-      return out;
-    }
-    const DetectorSet::Lease detector(*detectors);
-    out.det = detector->process(job, detect);
-    if (!bev_dir.empty()) out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg.perception, std::nullopt);
+// On a worker: compensation, perception, and the bird's-eye picture (it needs that worker's pipeline).
+// Everything that is written happens in deliver(), on the reading thread, in frame order: the output does not
+// depend on the number of workers.
+Processed Replay::process(FrameJob& job) {
+  Processed out;
+  if (!detectors_) {
+    out.det.frame = std::move(job.rotation);
     return out;
-  };
-  // Frame to frame, so here in frame order and not in the workers (obstacle_hold.hpp).
-  perception::ObstacleHold hold(cfg.perception.hold);
-  std::uint64_t held_total = 0;
-  std::vector<perception::Obstacle> held;  // one frame's held obstacles, for its picture
-  auto deliver = [&](const Pool::Result& r) {
-    if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
-      // Replay uses the non-dropping submit, so this is a failed pipeline run; it is reported, never skipped.
-      ++lost;
-      if (write_error.empty()) {
-        const FrameJob& j = *r.input;
-        write_error = "frame " + std::to_string(j.synced ? j.synced->seq : j.rotation.index) + " was not processed (" +
-                      sync::to_string(r.outcome) + (r.error != nullptr ? ": " + *r.error : std::string()) + ")";
-      }
+  }
+  const DetectorSet::Lease detector(*detectors_);
+  out.det = detector->process(job, detect_);
+  if (!bev_dir_.empty()) {
+    out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg_.perception, std::nullopt);
+  }
+  return out;
+}
+
+void Replay::deliver(const Pool::Result& r) {
+  if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
+    // Replay uses the non-dropping submit, so this is a failed pipeline run; it is reported, never skipped.
+    ++lost_;
+    if (write_error_.empty()) {
+      const FrameJob& j = *r.input;
+      write_error_ = "frame " + std::to_string(j.synced ? j.synced->seq : j.rotation.index) + " was not processed (" +
+                     sync::to_string(r.outcome) + (r.error != nullptr ? ": " + *r.error : std::string()) + ")";
+    }
+    return;
+  }
+  if (!write_error_.empty()) return;
+  write_frame(r);
+}
+
+// One processed frame's outputs, in frame order: its PCD, then (when detecting) the hold, the obstacles line,
+// the picture and the CAN stage's decision.
+void Replay::write_frame(const Pool::Result& r) {
+  const LidarFrame& f = r.output->det.frame;
+  const FusionInfo* fused = r.output->det.fusion ? &*r.output->det.fusion : nullptr;
+  char stem[64];
+  std::snprintf(stem, sizeof stem, "frame_%06llu%s", static_cast<unsigned long long>(f.index),
+                f.partial ? "_partial" : "");
+  if (!pcd_dir_.empty()) {
+    write_error_ = write_pcd((fs::path(pcd_dir_) / (std::string(stem) + ".pcd")).string(), f);
+    if (write_error_.empty()) ++written_;
+  }
+  if (!detect_) return;
+  perception::FrameResult& result = r.output->det.result;
+  // A fused frame levelled in full gives its pose: the hold moves what it remembers by the travel and turning.
+  const std::optional<perception::FramePose> pose =
+      fused != nullptr ? detection_pose(*fused, cfg_.lidar.mounting) : std::nullopt;
+  hold_.apply(f.host_stamp.ns, result, std::nullopt, pose);
+  held_total_ += result.counts.held;
+  if (result.counts.held > 0 && r.output->bev) {
+    held_.clear();
+    for (const auto& o : result.obstacles) {
+      if (o.held) held_.push_back(o);
+    }
+    draw_obstacles(*r.output->bev, held_);
+  }
+  obstacles_total_ += result.obstacles.size();
+  times_.push_back(result.times);
+  if (obstacles_out_.is_open() && write_error_.empty()) {
+    obstacles_out_ << obstacles_json_line(f, result, fused, &cfg_.lidar.mounting) << '\n';
+    if (!obstacles_out_) write_error_ = "cannot write " + *opt_.obstacles_out;
+  }
+  if (r.output->bev && write_error_.empty()) {
+    write_error_ = write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string(), *r.output->bev);
+  }
+  if (can_) decide(r, f, result);
+}
+
+// The safety monitor on one frame, with every sensor as it was heard at the frame's decision time.
+void Replay::decide(const Pool::Result& r, const LidarFrame& f, perception::FrameResult& result) {
+  static constexpr output::safety::Sensor kHeardSensor[] = {
+      output::safety::Sensor::Scan2d, output::safety::Sensor::Gnss, output::safety::Sensor::Ahrs};
+  for (std::size_t i = 0; i < heard_.size(); ++i) {
+    const Stamp t = heard_[i].at(r.input->complete);
+    if (t.ns != 0) can_->sensor_data(kHeardSensor[i], t);
+  }
+  while (!problems_.empty() && problems_.front().at.ns <= r.input->complete.ns) {
+    can_->sensor_problem(problems_.front().sensor, problems_.front().problem);
+    problems_.pop_front();
+  }
+  can_->frame(f, result, r.input->complete, lost_);
+  if (can_log_->stats().write_errors != 0 && write_error_.empty()) write_error_ = can_log_error();
+}
+
+void Replay::submit_jobs() {
+  const auto deliver = [this](const Pool::Result& r) { this->deliver(r); };
+  for (auto& j : jobs_) {
+    // Back-pressure instead of a drop: replay must lose no frame, so a full queue waits for results.
+    while (!pool_->try_submit(j)) pool_->poll_wait(deliver);
+    pool_->poll(deliver);
+  }
+  jobs_.clear();
+}
+
+void Replay::on_datagram(const io::UdpDatagram& dg) {
+  if (samples_) samples_->lidar(dg);
+  if (dg.dst_port == cfg_.lidar.data_port) {
+    if (dg.payload.size() != velodyne::kDataPacketSize) {
+      ++ports_.data_bad_length;
       return;
     }
-    if (!write_error.empty()) return;
-    const LidarFrame& f = r.output->det.frame;
-    const FusionInfo* fused = r.output->det.fusion ? &*r.output->det.fusion : nullptr;
-    char stem[64];
-    std::snprintf(stem, sizeof stem, "frame_%06llu%s", static_cast<unsigned long long>(f.index),
-                  f.partial ? "_partial" : "");
-    if (!pcd_dir.empty()) {
-      write_error = write_pcd((fs::path(pcd_dir) / (std::string(stem) + ".pcd")).string(), f);
-      if (write_error.empty()) ++written;
+    fusion_->lidar(dg.payload, dg.host_time, jobs_);
+    submit_jobs();
+  } else if (dg.dst_port == cfg_.lidar.position_port) {
+    ++pos_.packets;
+    auto p = velodyne::decode_position_packet(dg.payload);
+    if (!p) {
+      ++pos_.bad_length;
+      return;
     }
-    if (!detect) return;
-    perception::FrameResult& result = r.output->det.result;
-    // A fused frame levelled in full gives its pose: the hold moves what it remembers by the travel and turning.
-    const std::optional<perception::FramePose> pose =
-        fused != nullptr ? detection_pose(*fused, cfg.lidar.mounting) : std::nullopt;
-    hold.apply(f.host_stamp.ns, result, std::nullopt, pose);
-    held_total += result.counts.held;
-    if (result.counts.held > 0 && r.output->bev) {
-      held.clear();
-      for (const auto& o : result.obstacles) {
-        if (o.held) held.push_back(o);
-      }
-      draw_obstacles(*r.output->bev, held);
-    }
-    obstacles_total += result.obstacles.size();
-    times.push_back(result.times);
-    if (obstacles_out.is_open() && write_error.empty()) {
-      obstacles_out << obstacles_json_line(f, result, fused, &cfg.lidar.mounting) << '\n';
-      if (!obstacles_out) write_error = "cannot write " + *opt.obstacles_out;
-    }
-    if (r.output->bev && write_error.empty()) {
-      write_error = write_png((fs::path(bev_dir) / (std::string(stem) + ".png")).string(), *r.output->bev);
-    }
-    if (can) {
-      for (std::size_t i = 0; i < heard.size(); ++i) {
-        const Stamp t = heard[i].at(r.input->complete);
-        if (t.ns != 0) can->sensor_data(kHeardSensor[i], t);
-      }
-      while (!problems.empty() && problems.front().at.ns <= r.input->complete.ns) {
-        can->sensor_problem(problems.front().sensor, problems.front().problem);
-        problems.pop_front();
-      }
-      can->frame(f, result, r.input->complete, lost);
-      if (can_log->stats().write_errors != 0 && write_error.empty()) write_error = can_log_error();
-    }
-  };
-  sync::PoolParams pool_params;
-  pool_params.workers = workers;
-  pool_params.queue_capacity = static_cast<std::size_t>(cfg.pipeline.queue_capacity);
-  Pool pool(pool_params, process);
-  auto handle_jobs = [&] {
-    for (auto& j : jobs) {
-      // Back-pressure instead of a drop: replay must lose no frame, so a full queue waits for results.
-      while (!pool.try_submit(j)) pool.poll_wait(deliver);
-      pool.poll(deliver);
-    }
-    jobs.clear();
-  };
+    ++pos_.decoded;
+    if (p->rmc) ++pos_.rmc;
+    if (p->nmea_error) ++pos_.nmea_rejected;
+    pos_.last = std::move(p).value();
+  } else {
+    ++ports_.other_port;
+  }
+}
 
-  auto on_datagram = [&](const io::UdpDatagram& dg) {
-    if (samples) samples->lidar(dg);
-    if (dg.dst_port == cfg.lidar.data_port) {
-      if (dg.payload.size() != velodyne::kDataPacketSize) {
-        ++ports.data_bad_length;
-        return;
-      }
-      fusion.lidar(dg.payload, dg.host_time, jobs);
-      handle_jobs();
-    } else if (dg.dst_port == cfg.lidar.position_port) {
-      ++pos.packets;
-      auto p = velodyne::decode_position_packet(dg.payload);
-      if (!p) {
-        ++pos.bad_length;
-        return;
-      }
-      ++pos.decoded;
-      if (p->rmc) ++pos.rmc;
-      if (p->nmea_error) ++pos.nmea_rejected;
-      pos.last = std::move(p).value();
-    } else {
-      ++ports.other_port;
-    }
-  };
-  auto on_record = [&](LogKind kind, const io::ByteLogRecord& rec) {
-    const bool to_sensor = rec.direction == io::Direction::ToSensor;
-    switch (kind) {
-      case LogKind::Scan2d:
-        if (samples) samples->scan2d(rec.bytes, to_sensor);
-        fusion.scan2d_bytes(rec.bytes, to_sensor, rec.host_time, jobs);
-        break;
-      case LogKind::Gnss:
-        if (samples) samples->gnss(rec.bytes);
-        fusion.gnss(rec.bytes, rec.host_time, jobs);
-        break;
-      case LogKind::Ahrs:
-        if (samples) samples->ahrs(rec.bytes);
-        fusion.ahrs(rec.bytes, rec.host_time, jobs);
-        break;
-    }
-    if (!to_sensor) heard[static_cast<std::size_t>(kind)].add(rec.host_time);
-    if (can) {
-      const auto p = fusion.take_problems();
-      if (p.gnss != output::safety::Problem::None) problems.push_back({p.gnss_at, output::safety::Sensor::Gnss, p.gnss});
-      if (p.ahrs != output::safety::Problem::None) problems.push_back({p.ahrs_at, output::safety::Sensor::Ahrs, p.ahrs});
-    }
-    handle_jobs();
-  };
+void Replay::on_record(LogKind kind, const io::ByteLogRecord& rec) {
+  const bool to_sensor = rec.direction == io::Direction::ToSensor;
+  switch (kind) {
+    case LogKind::Scan2d:
+      if (samples_) samples_->scan2d(rec.bytes, to_sensor);
+      fusion_->scan2d_bytes(rec.bytes, to_sensor, rec.host_time, jobs_);
+      break;
+    case LogKind::Gnss:
+      if (samples_) samples_->gnss(rec.bytes);
+      fusion_->gnss(rec.bytes, rec.host_time, jobs_);
+      break;
+    case LogKind::Ahrs:
+      if (samples_) samples_->ahrs(rec.bytes);
+      fusion_->ahrs(rec.bytes, rec.host_time, jobs_);
+      break;
+  }
+  if (!to_sensor) heard_[static_cast<std::size_t>(kind)].add(rec.host_time);
+  if (can_) {
+    const auto p = fusion_->take_problems();
+    if (p.gnss != output::safety::Problem::None) problems_.push_back({p.gnss_at, output::safety::Sensor::Gnss, p.gnss});
+    if (p.ahrs != output::safety::Problem::None) problems_.push_back({p.ahrs_at, output::safety::Sensor::Ahrs, p.ahrs});
+  }
+  submit_jobs();
+}
 
-  // The capture and the byte logs, merged by receive time.
-  while (auto ev = recording->next()) {
-    if (first_time.ns == 0) {
-      first_time = ev->time;
-      if (can) can->start(first_time);
+void Replay::progress_line() {
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_progress_ <= std::chrono::seconds(1)) return;
+  last_progress_ = now;
+  std::fprintf(stderr, "\r  %llu records, %llu frames ...",
+               static_cast<unsigned long long>(recording_->capture().stats().records),
+               static_cast<unsigned long long>(fusion_->counts().frames));
+}
+
+void Replay::read() {
+  while (auto ev = recording_->next()) {
+    if (first_time_.ns == 0) {
+      first_time_ = ev->time;
+      if (can_) can_->start(first_time_);
     }
-    last_time = Stamp{std::max(last_time.ns, ev->time.ns)};
+    last_time_ = Stamp{std::max(last_time_.ns, ev->time.ns)};
     if (ev->datagram != nullptr) {
       on_datagram(*ev->datagram);
     } else {
       on_record(ev->kind, *ev->record);
     }
-    if (progress) {
-      const auto now = std::chrono::steady_clock::now();
-      if (now - last_progress > std::chrono::seconds(1)) {
-        last_progress = now;
-        std::fprintf(stderr, "\r  %llu records, %llu frames ...",
-                     static_cast<unsigned long long>(recording->capture().stats().records),
-                     static_cast<unsigned long long>(fusion.counts().frames));
-      }
-    }
+    if (progress_) progress_line();
   }
-  fusion.finish(last_time, jobs);
-  handle_jobs();
-  pool.stop(sync::Drain::Yes);
-  while (pool.outstanding() > 0 && pool.poll(deliver) > 0) {
+  fusion_->finish(last_time_, jobs_);
+  submit_jobs();
+  pool_->stop(sync::Drain::Yes);
+  const auto deliver = [this](const Pool::Result& r) { this->deliver(r); };
+  while (pool_->outstanding() > 0 && pool_->poll(deliver) > 0) {
   }
-  if (can) {
-    can->tick(last_time, lost);
-    if (can_log->stats().write_errors != 0 && write_error.empty()) write_error = can_log_error();
+  if (can_) {
+    can_->tick(last_time_, lost_);
+    if (can_log_->stats().write_errors != 0 && write_error_.empty()) write_error_ = can_log_error();
   }
-  if (progress) std::fprintf(stderr, "\r%60s\r", "");
+  if (progress_) std::fprintf(stderr, "\r%60s\r", "");
+}
 
-  const velodyne::Stream& stream = fusion.stream();
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const io::PcapStats& pcap_stats = recording->capture().stats();
-  print_summary(pcap_path, pcap_stats, stream, pos, ports, written, wall_s,
-                static_cast<double>(last_time.ns - first_time.ns) * 1e-9);
-  if (detect) {
-    std::printf("  obstacles         %llu", static_cast<unsigned long long>(obstacles_total));
-    if (cfg.perception.hold.enabled) {
-      std::printf(" (%llu of them held from fragments)", static_cast<unsigned long long>(held_total));
-    }
-    std::printf("\n");
-    print_stage_times(times);
-  }
-  std::printf("  workers           %zu, %llu frames lost\n", workers, static_cast<unsigned long long>(lost));
-  if (can) {
-    const auto& cc = can->counts();
-    std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", static_cast<unsigned long long>(cc.stop_frames),
-                static_cast<unsigned long long>(cc.go_frames), static_cast<unsigned long long>(cc.changes));
-    std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log->stats().sent));
-  }
-  for (const auto& l : recording->logs()) {
+void Replay::print_fusion_summary() const {
+  for (const auto& l : recording_->logs()) {
     std::printf("  %-17s %llu records (%s)%s%s\n", fs::path(l.file.path).filename().c_str(),
                 static_cast<unsigned long long>(l.records), l.source.c_str(), l.truncated ? ", cut short at the end" : "",
                 l.error.empty() ? "" : (", " + l.error).c_str());
   }
-  if (!logs.empty()) {
-    const auto& fc = fusion.counts();
+  if (!logs_.empty()) {
+    const auto& fc = fusion_->counts();
     std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages\n",
                 static_cast<unsigned long long>(fc.scans), static_cast<unsigned long long>(fc.gnss),
                 static_cast<unsigned long long>(fc.ahrs));
@@ -469,10 +509,10 @@ int replay(const ReplayOptions& opt) {
                   static_cast<unsigned long long>(fc.gnss_errors), static_cast<unsigned long long>(fc.ahrs_errors));
     }
   }
-  if (const sync::Synchronizer* sy = fusion.synchronizer()) {
+  if (const sync::Synchronizer* sy = fusion_->synchronizer()) {
     const auto& ac = sy->assembler().counters();
     std::printf("  fused frames      %llu at %.3g Hz: %llu complete, %llu timed out (", static_cast<unsigned long long>(ac.frames),
-                cfg.sync.rate_hz, static_cast<unsigned long long>(ac.complete), static_cast<unsigned long long>(ac.timed_out));
+                cfg_.sync.rate_hz, static_cast<unsigned long long>(ac.complete), static_cast<unsigned long long>(ac.timed_out));
     bool first = true;
     for (const sync::SensorKind k : sync::kAllSensors) {
       const auto n = ac.missing[static_cast<std::size_t>(k)];
@@ -483,32 +523,72 @@ int replay(const ReplayOptions& opt) {
     std::printf("%s), %llu late rotations dropped\n", first ? "none lacking a sensor" : "",
                 static_cast<unsigned long long>(ac.late_rotations));
   }
-  if (samples) samples->finish();
+}
 
-  if (pcap_stats.truncated) log->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path);
-  if (!pcap_stats.read_error.empty()) log->warn("{}: reading stopped early: {}", pcap_path, pcap_stats.read_error);
-  if (cfg.lidar.model != velodyne::Model::Unknown && stream.detector().decided() &&
-      *stream.detector().decided() != cfg.lidar.model) {
-    log->warn("lidar.model is {} but the packets look like a {} ({}); check the configuration",
-              velodyne::to_string(cfg.lidar.model), velodyne::to_string(*stream.detector().decided()),
-              stream.detector().reason());
+int Replay::finish() {
+  const velodyne::Stream& stream = fusion_->stream();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  const io::PcapStats& pcap_stats = recording_->capture().stats();
+  print_summary(pcap_path_, pcap_stats, stream, pos_, ports_, written_, wall_s,
+                static_cast<double>(last_time_.ns - first_time_.ns) * 1e-9);
+  if (detect_) {
+    std::printf("  obstacles         %llu", static_cast<unsigned long long>(obstacles_total_));
+    if (cfg_.perception.hold.enabled) {
+      std::printf(" (%llu of them held from fragments)", static_cast<unsigned long long>(held_total_));
+    }
+    std::printf("\n");
+    print_stage_times(times_);
   }
-  if (!write_error.empty()) {
-    std::fprintf(stderr, "fieldguard replay: %s\n", write_error.c_str());
+  std::printf("  workers           %zu, %llu frames lost\n", workers_, static_cast<unsigned long long>(lost_));
+  if (can_) {
+    const auto& cc = can_->counts();
+    std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", static_cast<unsigned long long>(cc.stop_frames),
+                static_cast<unsigned long long>(cc.go_frames), static_cast<unsigned long long>(cc.changes));
+    std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log_->stats().sent));
+  }
+  print_fusion_summary();
+  if (samples_) samples_->finish();
+
+  if (pcap_stats.truncated) log_->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path_);
+  if (!pcap_stats.read_error.empty()) log_->warn("{}: reading stopped early: {}", pcap_path_, pcap_stats.read_error);
+  if (cfg_.lidar.model != velodyne::Model::Unknown && stream.detector().decided() &&
+      *stream.detector().decided() != cfg_.lidar.model) {
+    log_->warn("lidar.model is {} but the packets look like a {} ({}); check the configuration",
+               velodyne::to_string(cfg_.lidar.model), velodyne::to_string(*stream.detector().decided()),
+               stream.detector().reason());
+  }
+  if (!write_error_.empty()) {
+    std::fprintf(stderr, "fieldguard replay: %s\n", write_error_.c_str());
     return kExitFailure;
   }
-  if (!logs.empty() && stream.counters().packets == 0) return kExitOk;  // a recording without 3D LiDAR data
+  if (!logs_.empty() && stream.counters().packets == 0) return kExitOk;  // a recording without 3D LiDAR data
   if (stream.counters().packets == 0) {
     std::fprintf(stderr, "fieldguard replay: %s holds no UDP datagram to the data port %u: not a Velodyne capture, or "
-                 "lidar.data_port is wrong\n", pcap_path.c_str(), cfg.lidar.data_port);
+                 "lidar.data_port is wrong\n", pcap_path_.c_str(), cfg_.lidar.data_port);
     return kExitBadInput;
   }
   if (stream.counters().decoded == 0) {
     std::fprintf(stderr, "fieldguard replay: none of the %llu datagrams to port %u in %s is a Velodyne data packet\n",
-                 static_cast<unsigned long long>(stream.counters().packets), cfg.lidar.data_port, pcap_path.c_str());
+                 static_cast<unsigned long long>(stream.counters().packets), cfg_.lidar.data_port, pcap_path_.c_str());
     return kExitBadInput;
   }
   return kExitOk;
+}
+
+}  // namespace
+
+int replay(const ReplayOptions& opt) {
+  const auto loaded = load_config_file(opt.config);
+  if (!loaded.ok()) {
+    for (const auto& issue : loaded.issues) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
+    std::fprintf(stderr, "fieldguard replay: invalid configuration %s\n", opt.config.c_str());
+    return kExitBadInput;
+  }
+  const Config& cfg = loaded.config;
+  Replay replay(opt, cfg, opt.workers.value_or(static_cast<std::size_t>(cfg.pipeline.workers)));
+  if (!replay.open()) return kExitBadInput;
+  replay.read();
+  return replay.finish();
 }
 
 }  // namespace fieldguard::app

@@ -1,6 +1,7 @@
 #pragma once
 // One named spdlog logger per module, all to stderr with a fixed pattern and no timestamps of our own
-// (under systemd the journal stamps lines). Private to the app module: no spdlog type leaves it.
+// (under systemd the journal stamps lines). For the application layer (engine, replay, daemon): no module
+// below it sees spdlog.
 
 #include <spdlog/logger.h>
 
