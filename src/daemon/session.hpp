@@ -1,0 +1,109 @@
+#pragma once
+// One configuration's worth of daemon (`fieldguard run`): its live sources, its frame maker, its worker pool
+// and its output stage, all on one io_context. A reload replaces the whole session; the CAN sink outlives it.
+// Thread contract: everything here runs on the io thread, but process(), which the pool's workers call.
+
+#include <boost/asio/io_context.hpp>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "daemon/run_stage.hpp"
+#include "daemon/systemd_notify.hpp"
+#include "fieldguard/config/config.hpp"
+#include "fieldguard/engine/fusion.hpp"
+#include "fieldguard/engine/logging.hpp"
+#include "fieldguard/io/can_reader.hpp"
+#include "fieldguard/io/scip_source.hpp"
+#include "fieldguard/io/serial_reader.hpp"
+#include "fieldguard/io/udp_receiver.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
+#include "fieldguard/sync/health.hpp"
+#include "fieldguard/sync/ordered_pool.hpp"
+
+namespace fieldguard::app {
+
+class Session {
+  using Pool = sync::OrderedPool<FrameJob, DetectedFrame>;
+  using SteadyClock = std::chrono::steady_clock;
+
+
+ public:
+  // `ready`: READY=1 was sent (by this process, for any session): the watchdog is fed only from then on.
+  Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink, SystemdNotifier& notify, bool& ready);
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+  Session(Session&&) = delete;
+  Session& operator=(Session&&) = delete;
+  ~Session() { stop(); }
+
+  // Throws std::system_error when the LiDAR's port cannot be bound.
+  void start();
+
+  // The tractor's speed off the bus sizes the stop zone. Without it (no SocketCAN, no interface) the zone
+  // keeps its full-speed length: safe, so the daemon runs on and says why once.
+  void start_speed_input();
+  // Sources closed, queued rotations discarded, the workers joined (each finishes its rotation first).
+  void stop();
+
+  void shutdown() { stage_.shutdown(wall_clock_now()); }
+
+  // The output timer: finished rotations in order, then a decision on the clock and the CAN cycles due.
+  void on_tick();
+
+  [[nodiscard]] std::string status(Stamp now) const;
+
+  // Also what tools/fieldguard-load reads: keep the labels stable.
+  void print_summary() const;
+
+  [[nodiscard]] const Config& config() const { return cfg_; }
+
+ private:
+  static sync::PoolParams pool_params(const Config& c);
+
+  DetectedFrame process(FrameJob& j);
+
+  void heard(output::safety::Sensor s, Stamp t);
+
+  void on_datagram(const io::UdpDatagram& d);
+  // Implausible GNSS / AHRS samples decoded since the last decision go to the next one.
+  void pass_problems();
+  void submit_jobs();
+  void deliver(const Pool::Result& r);
+
+  boost::asio::io_context& io_;
+  const Config cfg_;
+  SystemdNotifier& notify_;
+  bool& ready_;
+  std::shared_ptr<spdlog::logger> log_ = logger("run");
+  LiveStage stage_;
+  perception::ObstacleHold hold_{cfg_.perception.hold};
+  std::uint64_t held_ = 0;  // obstacles the hold reported
+  SensorFusion fusion_;
+  sync::HealthMonitor health_;
+  DetectorSet detectors_;
+  Pool pool_;
+  std::unique_ptr<io::UdpReceiver> udp_;
+  std::unique_ptr<io::ScipSource> scip_;
+  std::unique_ptr<io::CanReader> can_in_;
+  std::uint64_t speed_errors_ = 0;
+  std::vector<std::unique_ptr<io::SerialReader>> serial_;
+  std::vector<FrameJob> jobs_;
+  std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
+  // The detection times of the status and the summary: the last 5 s at 10 Hz.
+  static constexpr std::size_t kTimedRotations = 50;
+  std::deque<perception::StageTimes> timed_;  // Pipeline::process()'s of the last rotations delivered, oldest first
+  float worst_us_ = 0.F;                       // the longest process() of the run
+  std::uint64_t timed_count_ = 0;              // rotations delivered
+  std::uint64_t lost_ = 0;       // rotations dropped, refused or failed
+  std::uint64_t bad_length_ = 0;
+  bool heard_all_ = false;
+  bool stalled_ = false;
+  bool stopped_ = false;
+  SteadyClock::time_point last_status_{};
+};
+
+}  // namespace fieldguard::app
