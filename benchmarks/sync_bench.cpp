@@ -4,7 +4,15 @@
 
 #include <benchmark/benchmark.h>
 
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 #include "fieldguard/sync/frame_assembler.hpp"
@@ -71,6 +79,68 @@ void BM_PoolHandoffFrame(benchmark::State& state) {
   state.SetItemsProcessed(n);
 }
 BENCHMARK(BM_PoolHandoffFrame)->UseRealTime();
+
+// The daemon's hand-off from a worker back to the io thread, one frame at a time (the live case: a rotation
+// every 100 ms, each decided alone): submit on the io thread, the worker finishes it, and the io thread
+// delivers it. Time per frame from submit to delivery, the work itself being trivial.
+//   BM_DecisionWake:      the worker wakes the io thread (PoolParams::on_result -> asio post), as `run` does.
+//   BM_DecisionTimerPoll: the io thread polls on a timer of range(0) ms, as `run` did (5 ms) before.
+void BM_DecisionWake(benchmark::State& state) {
+  boost::asio::io_context io;
+  std::atomic<bool> pending{false};
+  std::function<void()> drain;
+  sync::PoolParams p;
+  p.workers = 1;
+  p.on_result = [&] {
+    if (pending.exchange(true)) return;
+    boost::asio::post(io, [&] {
+      pending.store(false);
+      drain();
+    });
+  };
+  sync::OrderedPool<std::uint64_t, std::uint64_t> pool(p, [](std::uint64_t& v) { return v * 3; });
+  std::uint64_t delivered = 0;
+  drain = [&] { pool.poll([&](const auto&) { ++delivered; }); };
+  const auto work = boost::asio::make_work_guard(io);  // run_one() waits for the worker's post
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    std::uint64_t v = i++;
+    pool.submit(v);
+    while (delivered < i) io.run_one();
+  }
+  pool.stop(sync::Drain::Yes);
+  state.SetItemsProcessed(static_cast<std::int64_t>(i));
+}
+BENCHMARK(BM_DecisionWake)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+void BM_DecisionTimerPoll(benchmark::State& state) {
+  boost::asio::io_context io;
+  sync::PoolParams p;
+  p.workers = 1;
+  sync::OrderedPool<std::uint64_t, std::uint64_t> pool(p, [](std::uint64_t& v) { return v * 3; });
+  std::uint64_t delivered = 0;
+  boost::asio::steady_timer timer(io);
+  const auto period = std::chrono::milliseconds(state.range(0));
+  std::function<void()> arm = [&] {
+    timer.expires_after(period);
+    timer.async_wait([&](const boost::system::error_code& ec) {
+      if (ec) return;
+      pool.poll([&](const auto&) { ++delivered; });
+      arm();
+    });
+  };
+  arm();
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    std::uint64_t v = i++;
+    pool.submit(v);
+    while (delivered < i) io.run_one();
+  }
+  timer.cancel();
+  pool.stop(sync::Drain::Yes);
+  state.SetItemsProcessed(static_cast<std::int64_t>(i));
+}
+BENCHMARK(BM_DecisionTimerPoll)->Arg(5)->UseRealTime()->Unit(benchmark::kMicrosecond);
 
 LidarFrame rotation(std::uint64_t index, std::int64_t t, std::int64_t period, std::size_t points) {
   LidarFrame f;

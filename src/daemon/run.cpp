@@ -1,8 +1,9 @@
 // `fieldguard run`: the daemon. The live sources, the frame maker (SensorFusion: rotations, or fused frames
 // when a 2D LiDAR, GNSS or AHRS is enabled) and the output stage share one Boost.Asio io_context on the main
-// thread (the io thread); compensation and perception run on an OrderedPool of pipeline.workers threads. A
-// 5 ms timer on the io thread collects finished frames in order, lets the safety monitor decide on them and,
-// between frames, on the clock alone, and sends the CAN frames that are due.
+// thread (the io thread); compensation and perception run on an OrderedPool of pipeline.workers threads. A worker
+// that finishes a frame wakes the io thread (session.hpp), which decides it and writes its CAN frames at once. A
+// 5 ms timer on the io thread does what is periodic: the safety monitor's decision on the clock alone (a sensor
+// that falls silent, a stalled pipeline), the heartbeats, frames that wait for a late sensor, the status.
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>

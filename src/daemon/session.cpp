@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 
+#include <boost/asio/post.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <optional>
@@ -41,7 +42,16 @@ Session::Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink,
       stage_(cfg_, sink),
       fusion_(cfg_, FusionInputs::enabled_in(cfg_)),
       detectors_(cfg_, static_cast<std::size_t>(cfg_.pipeline.workers)),
-      pool_(pool_params(cfg_), [this](FrameJob& j) { return process(j); }) {}
+      pool_(pool_params(cfg_, io, waker_), [this](FrameJob& j) { return process(j); }) {
+  waker_->session = this;
+}
+
+Session::~Session() {
+  stop();
+  waker_->session = nullptr;  // a wake-up still queued on the io thread finds nobody
+}
+
+std::uint16_t Session::lidar_port() const { return udp_ ? udp_->local_port() : 0; }
 
 void Session::start() {
   const Stamp now = wall_clock_now();
@@ -121,6 +131,11 @@ void Session::stop() {
   if (can_in_) can_in_->stop();
   for (auto& s : serial_) s->stop();
   pool_.stop(sync::Drain::No);
+  pool_.poll([this](const Pool::Result& r) { deliver(r); });
+}
+
+void Session::on_results() {
+  pass_problems();
   pool_.poll([this](const Pool::Result& r) { deliver(r); });
 }
 
@@ -217,11 +232,19 @@ void Session::print_summary() const {
   }
 }
 
-sync::PoolParams Session::pool_params(const Config& c) {
+sync::PoolParams Session::pool_params(const Config& c, boost::asio::io_context& io, std::shared_ptr<Waker> waker) {
   sync::PoolParams p;
   p.workers = static_cast<std::size_t>(c.pipeline.workers);
   p.queue_capacity = static_cast<std::size_t>(c.pipeline.queue_capacity);
   p.drop = c.pipeline.drop == PipelineDrop::Oldest ? sync::DropPolicy::DropOldest : sync::DropPolicy::DropNewest;
+  // A result ready: the io thread decides it now, not at the next tick of the output timer.
+  p.on_result = [&io, waker = std::move(waker)] {
+    if (waker->pending.exchange(true, std::memory_order_acq_rel)) return;  // a wake-up is already queued
+    boost::asio::post(io, [waker] {
+      waker->pending.store(false, std::memory_order_release);  // before polling: a later result posts again
+      if (waker->session != nullptr) waker->session->on_results();
+    });
+  };
   return p;
 }
 

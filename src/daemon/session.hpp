@@ -4,6 +4,7 @@
 // Thread contract: everything here runs on the io thread, but process(), which the pool's workers call.
 
 #include <boost/asio/io_context.hpp>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -38,7 +39,7 @@ class Session {
   Session& operator=(const Session&) = delete;
   Session(Session&&) = delete;
   Session& operator=(Session&&) = delete;
-  ~Session() { stop(); }
+  ~Session();
 
   // Throws std::system_error when the LiDAR's port cannot be bound.
   void start();
@@ -51,7 +52,9 @@ class Session {
 
   void shutdown() { stage_.shutdown(wall_clock_now()); }
 
-  // The output timer: finished rotations in order, then a decision on the clock and the CAN cycles due.
+  // The output timer, for what is periodic: a decision on the clock (timeouts), the CAN cycles due, frames
+  // that waited for a late sensor past sync.timeout_s, the status. Finished frames do not wait for it:
+  // on_results() decides them as soon as a worker is done (it polls here too, which finds nothing then).
   void on_tick();
 
   [[nodiscard]] std::string status(Stamp now) const;
@@ -60,9 +63,20 @@ class Session {
   void print_summary() const;
 
   [[nodiscard]] const Config& config() const { return cfg_; }
+  // The port the 3D LiDAR's datagrams are read on (lidar.data_port, or the one the kernel chose for 0).
+  [[nodiscard]] std::uint16_t lidar_port() const;
+  [[nodiscard]] const LiveStageCounts& counts() const { return stage_.counts(); }
 
  private:
-  static sync::PoolParams pool_params(const Config& c);
+  // How a worker that finished a frame wakes the io thread: one asio post per burst of results (pending), to a
+  // session that may have been replaced meanwhile (session: set and cleared on the io thread only).
+  struct Waker {
+    std::atomic<bool> pending{false};
+    Session* session = nullptr;
+  };
+  static sync::PoolParams pool_params(const Config& c, boost::asio::io_context& io, std::shared_ptr<Waker> waker);
+  // The io thread, woken by a worker: the finished frames in order, each decided and its CAN frames written.
+  void on_results();
 
   DetectedFrame process(FrameJob& j);
 
@@ -85,6 +99,7 @@ class Session {
   SensorFusion fusion_;
   sync::HealthMonitor health_;
   DetectorSet detectors_;
+  std::shared_ptr<Waker> waker_ = std::make_shared<Waker>();
   Pool pool_;
   std::unique_ptr<io::UdpReceiver> udp_;
   std::unique_ptr<io::ScipSource> scip_;

@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <cstdint>
 #include <set>
 #include <stdexcept>
@@ -326,6 +328,44 @@ TEST(OrderedPool, DestructorStopsIdleAndBusyPools) {
     }
   }
   SUCCEED();  // reaching here means every worker was woken and joined
+}
+
+// The daemon's hand-off: a consumer that only polls when told (PoolParams::on_result, called on the worker that
+// finished) still gets every result, in order, and is told at least once after the last one. Runs under TSan.
+TEST(OrderedPool, OnResultWakesAConsumerThatPollsOnlyWhenTold) {
+  std::mutex m;
+  std::condition_variable cv;
+  std::uint64_t told = 0;
+  PoolParams p;
+  p.workers = 4;
+  p.queue_capacity = 64;
+  p.on_result = [&] {
+    const std::lock_guard lock(m);
+    ++told;
+    cv.notify_one();
+  };
+  OrderedPool<Item, std::uint64_t> pool(p, [](Item& it) { return digest(it); });
+  constexpr std::uint64_t kItems = 200;
+  constexpr std::uint64_t kBatch = 50;  // fits the pool's slots: nothing is refused or dropped
+  std::vector<std::uint64_t> seqs;
+  std::uint64_t seen = 0;
+  for (std::uint64_t i = 0; i < kItems;) {
+    for (const std::uint64_t end = i + kBatch; i < end; ++i) ASSERT_TRUE(pool.submit(make_item(i)));
+    while (seqs.size() < i) {
+      {
+        std::unique_lock lock(m);
+        cv.wait(lock, [&] { return told > seen; });  // no timeout: a missing wake-up hangs and fails the test
+        seen = told;
+      }
+      pool.poll([&](const auto& r) {
+        ASSERT_EQ(r.outcome, Outcome::Processed);
+        seqs.push_back(r.input->seq);
+      });
+    }
+  }
+  for (std::uint64_t i = 0; i < kItems; ++i) EXPECT_EQ(seqs[i], i);
+  EXPECT_GE(seen, 1U);
+  pool.stop(Drain::Yes);
 }
 
 TEST(OrderedPool, RejectsBadParameters) {

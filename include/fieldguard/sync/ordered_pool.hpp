@@ -17,6 +17,7 @@
 // - A job whose processing throws is reported as Outcome::Failed with the exception's message.
 // - stop(Drain::Yes) processes what is queued; stop(Drain::No) discards it (Outcome::Discarded). Either way the
 //   consumer's next poll() hands out every remaining ticket, in order.
+// - PoolParams::on_result tells the consumer that a result is ready, so that it need not poll on a timer.
 // - Accounting, once stopped and polled empty: submitted = processed + failed + dropped + discarded (+ refused,
 //   which never entered).
 
@@ -57,6 +58,10 @@ struct PoolParams {
   std::size_t queue_capacity = 8;   // inputs waiting for a worker, 1..4096
   std::size_t reorder_slack = 16;   // extra slots for results waiting for the consumer or for their turn
   DropPolicy drop = DropPolicy::DropOldest;
+  // Called, when set, each time a result becomes ready for poll(): on the worker that finished the job (or on the
+  // producer's or owner's thread for a drop or a discard). It must not block: the daemon posts a wake-up to its
+  // io thread with it, so that a finished frame is decided at once instead of at the next timer tick.
+  std::function<void()> on_result;
 };
 
 struct PoolCounters {
@@ -272,6 +277,7 @@ class OrderedPool {
     }
     done_epoch_.fetch_add(1, std::memory_order_acq_rel);
     done_epoch_.notify_all();
+    if (params_.on_result) params_.on_result();
   }
 
   void deliver(Slot& s, const Sink& sink) {
