@@ -72,7 +72,7 @@ class EuclideanClusterer {
   void extract_grid(const Cloud& in, Clusters& out);
   void finish_cluster(Clusters& out);
   [[nodiscard]] float grown(float growth, float cap, float range_m) const;
-  struct RadiusModel;  // the radii, for the hot loops (euclidean_cluster.cpp)
+  struct RadiusModel;  // the radii, for the hot loops (src/perception/euclidean_cluster_radius.hpp)
   [[nodiscard]] RadiusModel radius_model() const;
   // Inside the ellipsoid of horizontal radius sqrt(h2), vertical sqrt(v2): dxy2 / h2 + dz2 / v2 < 1, without
   // dividing.
