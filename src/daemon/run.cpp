@@ -22,6 +22,7 @@
 #include "fieldguard/daemon/daemon.hpp"
 #include "fieldguard/engine/logging.hpp"
 #include "fieldguard/output/can_sink.hpp"
+#include "fieldguard/sync/threads.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -80,6 +81,7 @@ class Daemon {
 
  private:
   std::unique_ptr<Session> open_session(const Config& cfg);
+  void apply_realtime(const RealtimeConfig& rt);
   void arm_timer();
   void wait_signal();
   void reload();
@@ -94,6 +96,8 @@ class Daemon {
   std::unique_ptr<output::CanSink> sink_;
   std::unique_ptr<Session> session_;
   bool ready_ = false;  // READY=1 sent, by any session of this process
+  bool io_refusal_logged_ = false;
+  bool memory_locked_ = false;  // mlockall tried
 };
 
 bool Daemon::open() {
@@ -119,7 +123,32 @@ bool Daemon::open() {
   return true;
 }
 
+// The io thread (this one) gets the configuration's scheduling before the session's workers are created; what
+// the system refuses is said once per run, and the daemon goes on without it.
+void Daemon::apply_realtime(const RealtimeConfig& rt) {
+  const sync::ThreadSettings io{"fg-io", rt.policy, rt.io_priority, rt.io_cpus};
+  if (std::string refused = sync::apply_to_this_thread(io); !refused.empty()) {
+    if (!io_refusal_logged_) {
+      log_->warn("realtime: the io thread runs without what the system refused ({}); it goes on at normal priority",
+                 refused);
+    }
+    io_refusal_logged_ = true;
+  } else if (rt.policy != sync::SchedPolicy::Other) {
+    log_->info("realtime: io thread {}, perception workers {}", sync::describe(io),
+               sync::describe({"", rt.policy, rt.worker_priority, {}}));
+  }
+  if (rt.lock_memory && !memory_locked_) {
+    if (std::string refused = sync::lock_all_memory(); !refused.empty()) {
+      log_->warn("realtime: memory not locked ({}); pages may fault in on the stop path", refused);
+    } else {
+      log_->info("realtime: memory locked");
+    }
+    memory_locked_ = true;  // tried once: a reload does not try (or say) it again
+  }
+}
+
 std::unique_ptr<Session> Daemon::open_session(const Config& cfg) {
+  apply_realtime(cfg.realtime);
   auto s = std::make_unique<Session>(io_, cfg, *sink_, notify_, ready_);
   s->start();
   return s;
@@ -129,7 +158,7 @@ void Daemon::arm_timer() {
   timer_.expires_after(kTick);
   timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec) return;
-    session_->on_tick();
+    session_->on_tick(std::chrono::steady_clock::now() - timer_.expiry());
     arm_timer();
   });
 }

@@ -139,7 +139,15 @@ void Session::on_results() {
   pool_.poll([this](const Pool::Result& r) { deliver(r); });
 }
 
-void Session::on_tick() {
+void Session::on_tick(std::chrono::nanoseconds late) {
+  io_gap_.add(late.count());
+  if (!worker_refusal_logged_) {
+    if (std::string refused = pool_.thread_refusal(); !refused.empty()) {
+      worker_refusal_logged_ = true;
+      log_->warn("realtime: the perception workers run without what the system refused ({}); detection goes on at "
+                 "normal priority", refused);
+    }
+  }
   pass_problems();
   pool_.poll([this](const Pool::Result& r) { deliver(r); });
   const Stamp now = wall_clock_now();
@@ -189,6 +197,13 @@ std::string Session::status(Stamp now) const {
     if (auto w = sy->waiting_for(now)) line += " | sync waiting for " + std::string(sync::to_string(*w));
   }
   if (stalled_) line += " | pipeline stalled";
+  if (latency_.count() > 0) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, " | latency p99 %.2f ms (max %.2f), io gap max %.2f ms, %llu late",
+                  static_cast<double>(latency_.quantile_ns(0.99)) * 1e-6, static_cast<double>(latency_.max_ns()) * 1e-6,
+                  static_cast<double>(io_gap_.max_ns()) * 1e-6, static_cast<unsigned long long>(late_));
+    line += buf;
+  }
   if (!timed_.empty()) {
     // The last rotations' detection times (one worker's, per rotation): headroom against the frame period.
     std::vector<float> v(timed_.size());
@@ -225,6 +240,13 @@ void Session::print_summary() const {
     std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages; errors %llu, %llu, %llu\n",
                 u(fc.scans), u(fc.gnss), u(fc.ahrs), u(fc.scan_errors), u(fc.gnss_errors), u(fc.ahrs_errors));
   }
+  const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };
+  std::printf("  latency           median %.3f ms, p99 %.3f ms, max %.3f ms over %llu frames (last packet to stop "
+              "request); %llu late (over %.1f ms)\n",
+              ms(latency_.quantile_ns(0.5)), ms(latency_.quantile_ns(0.99)), ms(latency_.max_ns()), u(latency_.count()),
+              u(late_), cfg_.realtime.latency_budget_ms);
+  std::printf("  io loop           longest gap %.3f ms (a due timer waited that long for the io thread)\n",
+              ms(io_gap_.max_ns()));
   if (!timed_.empty()) {
     const std::vector<perception::StageTimes> last(timed_.begin(), timed_.end());
     std::printf("  pipeline time     %s (the last %zu rotations); worst %.3f ms of all %llu\n",
@@ -237,6 +259,8 @@ sync::PoolParams Session::pool_params(const Config& c, boost::asio::io_context& 
   p.workers = static_cast<std::size_t>(c.pipeline.workers);
   p.queue_capacity = static_cast<std::size_t>(c.pipeline.queue_capacity);
   p.drop = c.pipeline.drop == PipelineDrop::Oldest ? sync::DropPolicy::DropOldest : sync::DropPolicy::DropNewest;
+  // Named so that `top -H`, a debugger and the stall test can tell the workers apart; scheduled below the io thread.
+  p.worker = {"fg-perception", c.realtime.policy, c.realtime.worker_priority, c.realtime.worker_cpus};
   // A result ready: the io thread decides it now, not at the next tick of the output timer.
   p.on_result = [&io, waker = std::move(waker)] {
     if (waker->pending.exchange(true, std::memory_order_acq_rel)) return;  // a wake-up is already queued
@@ -249,12 +273,6 @@ sync::PoolParams Session::pool_params(const Config& c, boost::asio::io_context& 
 }
 
 DetectedFrame Session::process(FrameJob& j) {
-  // Named so that `top -H`, a debugger and the stall test can tell the workers apart.
-  thread_local bool named = false;
-  if (!named) {
-    named = true;
-    pthread_setname_np(pthread_self(), "fg-perception");
-  }
   const DetectorSet::Lease detector(detectors_);
   return detector->process(j);
 }
@@ -323,6 +341,13 @@ void Session::deliver(const Pool::Result& r) {
       r.output->fusion ? detection_pose(*r.output->fusion, cfg_.lidar.mounting) : std::nullopt;
   held_ += hold_.apply(r.output->frame.host_stamp.ns, r.output->result, stage_.speed_at(now), pose);
   stage_.frame(r.output->frame, r.output->result, r.input->complete, now, lost_);
+  // From the kernel's receive time of the rotation's last packet to the write of its stop request (just done).
+  const std::int64_t latency_ns = wall_clock_now().ns - r.input->complete.ns;
+  latency_.add(latency_ns);
+  if (static_cast<double>(latency_ns) * 1e-6 > cfg_.realtime.latency_budget_ms && late_++ == 0) {
+    log_->warn("frame decided {:.3f} ms after its last packet, over realtime.latency_budget_ms {} (counted; this "
+               "is said once)", static_cast<double>(latency_ns) * 1e-6, cfg_.realtime.latency_budget_ms);
+  }
   if (ready_) notify_.progress(SteadyClock::now());
 }
 

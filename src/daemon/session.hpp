@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "daemon/run_stage.hpp"
+#include "fieldguard/core/latency_stats.hpp"
 #include "daemon/systemd_notify.hpp"
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/engine/fusion.hpp"
@@ -55,7 +56,8 @@ class Session {
   // The output timer, for what is periodic: a decision on the clock (timeouts), the CAN cycles due, frames
   // that waited for a late sensor past sync.timeout_s, the status. Finished frames do not wait for it:
   // on_results() decides them as soon as a worker is done (it polls here too, which finds nothing then).
-  void on_tick();
+  // `late`: how long after its expiry the timer ran: the longest such wait is the io loop's gap.
+  void on_tick(std::chrono::nanoseconds late = {});
 
   [[nodiscard]] std::string status(Stamp now) const;
 
@@ -117,6 +119,10 @@ class Session {
   std::uint64_t bad_length_ = 0;
   bool heard_all_ = false;
   bool stalled_ = false;
+  LatencyStats latency_;        // per frame: last packet's kernel receive time to its stop request's write
+  LatencyStats io_gap_;         // per tick: how late the output timer ran
+  std::uint64_t late_ = 0;      // frames over realtime.latency_budget_ms
+  bool worker_refusal_logged_ = false;
   bool stopped_ = false;
   SteadyClock::time_point last_status_{};
 };

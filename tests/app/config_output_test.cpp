@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <string>
+#include <vector>
 
 #include "app/config_issues.hpp"
 #include "fieldguard/config/config.hpp"
@@ -110,6 +111,56 @@ TEST(ConfigOutput, SpeedFromTheBus) {
   const auto bad = load_config_text("can:\n  speed: gps\n  speed_timeout_s: 0\n", "b.yaml");
   EXPECT_TRUE(has_issue(bad, "can.speed", "", 2)) << dump(bad);
   EXPECT_TRUE(has_issue(bad, "can.speed_timeout_s", "", 3)) << dump(bad);
+}
+
+TEST(ConfigRealtime, ReadsEveryKeyAndDefaultsToNormalScheduling) {
+  const auto defaults = load_config_text("lidar: {data_port: 2368}\n", "d.yaml");
+  ASSERT_TRUE(defaults.ok()) << dump(defaults);
+  EXPECT_EQ(defaults.config.realtime.policy, sync::SchedPolicy::Other);
+  EXPECT_FALSE(defaults.config.realtime.lock_memory);
+  EXPECT_TRUE(defaults.config.realtime.io_cpus.empty());
+  const auto r = load_config_text(R"(realtime:
+  policy: rr
+  io_priority: 70
+  worker_priority: 20
+  io_cpus: [1]
+  worker_cpus: [0, 1]
+  lock_memory: true
+  latency_budget_ms: 2.5
+)",
+                                  "rt.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const RealtimeConfig& rt = r.config.realtime;
+  EXPECT_EQ(rt.policy, sync::SchedPolicy::RoundRobin);
+  EXPECT_EQ(rt.io_priority, 70);
+  EXPECT_EQ(rt.worker_priority, 20);
+  EXPECT_EQ(rt.io_cpus, std::vector<int>({1}));
+  EXPECT_EQ(rt.worker_cpus, std::vector<int>({0, 1}));
+  EXPECT_TRUE(rt.lock_memory);
+  EXPECT_DOUBLE_EQ(rt.latency_budget_ms, 2.5);
+}
+
+TEST(ConfigRealtime, ReportsEveryProblemWithItsLine) {
+  const auto r = load_config_text(R"(realtime:
+  policy: deadline
+  io_priority: 0
+  worker_priority: 100
+  io_cpus: 1
+  worker_cpus: [0, x, -1]
+  lock_memory: yes
+  latency_budget_ms: 0
+  nice: 5
+)",
+                                  "bad.yaml");
+  EXPECT_TRUE(testing::has_issue(r, "realtime.policy", "deadline", 2)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.io_priority", "", 3)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.worker_priority", "", 4)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.io_cpus", "list of CPU numbers", 5)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.worker_cpus", "'x' is not a CPU number", 6)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.worker_cpus", "'-1' is not a CPU number", 6)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.lock_memory", "", 7)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.latency_budget_ms", "", 8)) << dump(r);
+  EXPECT_TRUE(testing::has_issue(r, "realtime.nice", "unknown key", 9)) << dump(r);
 }
 
 }  // namespace

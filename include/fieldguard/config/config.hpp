@@ -78,6 +78,7 @@ struct Config {
   perception::PipelineParams perception;
   output::safety::Params safety;  // the stop decision
   PipelineConfig pipeline;        // the perception worker pool
+  RealtimeConfig realtime;        // the daemon's threads: scheduling, affinity, locked memory, latency budget
   CanConfig can;                  // the CAN output
 };
 

@@ -1,11 +1,14 @@
 #pragma once
-// The configuration of the pipeline's worker pool (`pipeline:`) and of the CAN output (`can:`): plain values
+// The configuration of the pipeline's worker pool (`pipeline:`), the threads' scheduling (`realtime:`) and of
+// the CAN output (`can:`): plain values
 // with defaults, filled and checked by the config loader (src/app/config_pipeline.cpp, config_can.cpp).
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "fieldguard/output/can_encoder.hpp"
+#include "fieldguard/sync/threads.hpp"
 
 namespace fieldguard::app {
 
@@ -16,6 +19,18 @@ struct PipelineConfig {
   int workers = 1;          // perception threads, 1..64
   int queue_capacity = 8;   // rotations waiting for a worker, 1..4096
   PipelineDrop drop = PipelineDrop::Oldest;  // live, a full queue drops (and counts) this one; replay never drops
+};
+
+// How the daemon's threads are scheduled (`realtime:`). Each setting is optional: one the system refuses is
+// logged once and the daemon runs on without it.
+struct RealtimeConfig {
+  sync::SchedPolicy policy = sync::SchedPolicy::Other;  // fifo | rr: real-time scheduling for the io thread and the workers
+  int io_priority = 50;                     // 1..99, under fifo | rr
+  int worker_priority = 40;                 // 1..99, under fifo | rr
+  std::vector<int> io_cpus;                 // CPU affinity of the io thread; empty: any
+  std::vector<int> worker_cpus;             // CPU affinity of the perception workers; empty: any
+  bool lock_memory = false;                 // mlockall(MCL_CURRENT | MCL_FUTURE)
+  double latency_budget_ms = 10.0;          // a frame decided later than this after its last packet counts as late
 };
 
 enum class CanSinkKind : std::uint8_t { SocketCan, Candump, None };

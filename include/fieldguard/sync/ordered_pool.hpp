@@ -36,7 +36,10 @@
 #include <vector>
 
 #include <boost/lockfree/policies.hpp>
+#include <mutex>
 #include <boost/lockfree/queue.hpp>
+
+#include "fieldguard/sync/threads.hpp"
 
 namespace fieldguard::sync {
 
@@ -62,6 +65,9 @@ struct PoolParams {
   // producer's or owner's thread for a drop or a discard). It must not block: the daemon posts a wake-up to its
   // io thread with it, so that a finished frame is decided at once instead of at the next timer tick.
   std::function<void()> on_result;
+  // Each worker applies these to itself when it starts (name, scheduling, affinity: threads.hpp); what the
+  // system refused is kept for thread_refusal().
+  ThreadSettings worker;
 };
 
 struct PoolCounters {
@@ -175,6 +181,12 @@ class OrderedPool {
     return c;
   }
   [[nodiscard]] const PoolParams& params() const { return params_; }
+  // What the system refused of PoolParams::worker, on the first worker that was refused anything; empty when
+  // every worker that has started got its settings. Any thread.
+  [[nodiscard]] std::string thread_refusal() const {
+    const std::lock_guard lock(refusal_mutex_);
+    return refusal_;
+  }
 
  private:
   struct Slot {
@@ -236,6 +248,10 @@ class OrderedPool {
   }
 
   void work() {
+    if (std::string refused = apply_to_this_thread(params_.worker); !refused.empty()) {
+      const std::lock_guard lock(refusal_mutex_);
+      if (refusal_.empty()) refusal_ = std::move(refused);
+    }
     for (;;) {
       if (stopped_.load(std::memory_order_acquire) && !drain_) return;
       Slot* s = nullptr;
@@ -325,6 +341,8 @@ class OrderedPool {
   std::atomic<bool> stopping_{false};
   bool drain_ = true;  // written before stopped_ is released, read after it is acquired
   std::vector<std::thread> workers_;
+  mutable std::mutex refusal_mutex_;
+  std::string refusal_;
   // Consumer only.
   std::map<std::uint64_t, Slot*> waiting_;
   std::atomic<std::uint64_t> next_out_{0};  // written by the consumer only; atomic for counters()
