@@ -8,10 +8,14 @@
 #include <iostream>
 #include <string_view>
 
+#include "cli/cli.hpp"
 #include "fieldguard/output/dbc.hpp"
 
 namespace {
 
+namespace cli = fieldguard::tools::cli;
+
+// A J1939 address: 0..255, decimal or 0x hex.
 bool parse_address(std::string_view s, std::uint8_t& out) {
   int base = 10;
   if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
@@ -20,40 +24,33 @@ bool parse_address(std::string_view s, std::uint8_t& out) {
   }
   unsigned v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v, base);
-  if (r.ec != std::errc{} || r.ptr != s.data() + s.size() || v > 0xFF) return false;
+  if (s.empty() || r.ec != std::errc{} || r.ptr != s.data() + s.size() || v > 0xFF) return false;
   out = static_cast<std::uint8_t>(v);
   return true;
-}
-
-int usage(int code) {
-  (code == 0 ? std::cout : std::cerr)
-      << "usage: fieldguard-dbc [--source-address A] [--controller-address A]\n"
-         "Prints the DBC of fieldguard's CAN messages (addresses decimal or 0x hex; defaults 0x80 and 0x26).\n";
-  return code;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   fieldguard::output::CanParams p;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--help" || a == "-h") return usage(0);
-    if ((a == "--source-address" || a == "--controller-address") && i + 1 < argc) {
-      std::uint8_t v = 0;
-      if (!parse_address(argv[++i], v)) {
-        std::cerr << "fieldguard-dbc: " << a << ": not an address 0..255: " << argv[i] << "\n";
-        return 2;
-      }
-      (a == "--source-address" ? p.source_address : p.controller_address) = v;
-      continue;
-    }
-    std::cerr << "fieldguard-dbc: unknown argument " << a << "\n";
-    return usage(2);
-  }
+  cli::Tool tool("fieldguard-dbc", "fieldguard-dbc [--source-address A] [--controller-address A]",
+                 "Prints the DBC of fieldguard's CAN messages (addresses decimal or 0x hex; defaults 0x80 and 0x26).",
+                 "`fieldguard-dbc > config/fieldguard.dbc` regenerates the shipped file; the address options print\n"
+                 "the DBC for another tractor's bus.\n"
+                 "Exit codes: 0 printed; 1 writing failed; 2 bad command line or addresses.");
+  CLI::App& app = tool.app();
+  const auto any = [](std::uint8_t /*address*/) { return true; };
+  const std::string address = "an address 0..255 (decimal or 0x hex)";
+  cli::checked(app, "--source-address", p.source_address, parse_address, any, address,
+               "fieldguard's own source address on the bus (default 0x80)")
+      ->type_name("A");
+  cli::checked(app, "--controller-address", p.controller_address, parse_address, any, address,
+               "the steering controller's address the stop request goes to (default 0x26)")
+      ->type_name("A");
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
   if (const auto problems = fieldguard::output::validate(p); !problems.empty()) {
     for (const auto& s : problems) std::cerr << "fieldguard-dbc: " << s << "\n";
-    return 2;
+    return cli::kExitBadCommandLine;
   }
   try {
     std::cout << fieldguard::output::dbc_text(p);

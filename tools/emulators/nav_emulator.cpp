@@ -31,30 +31,26 @@
 #include <thread>
 #include <vector>
 
+#include "emulator_cli.hpp"
 #include "nav_encode.hpp"
-#include "options.hpp"
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: fieldguard-nav-emulator [--gnss-link PATH] [--ahrs-link PATH] [--gnss-rate HZ] [--ahrs-rate HZ]\n"
+namespace cli = fieldguard::tools::cli;
+
+constexpr const char* kSynopsis =
+    "fieldguard-nav-emulator [--gnss-link PATH] [--ahrs-link PATH] [--gnss-rate HZ] [--ahrs-rate HZ]\n"
     "                               [--gnss-baud N] [--ahrs-baud N] [--lat DEG] [--lon DEG] [--height M]\n"
     "                               [--geoid M] [--heading DEG] [--speed MPS] [--fine-start TICKS]\n"
-    "                               [--duration S]\n"
-    "  --gnss-link PATH   make PATH a symlink to the GNSS pty's slave device (like /dev/serial/by-id/...)\n"
-    "  --ahrs-link PATH   the same for the AHRS\n"
-    "  --gnss-rate HZ     NMEA epochs (GGA, RMC, HDT) a second, on the UTC grid (default 10)\n"
-    "  --ahrs-rate HZ     MTData2 messages a second (default 100)\n"
-    "  --gnss-baud N      line rate of the GNSS (default 115200); the epochs must fit in it\n"
-    "  --ahrs-baud N      line rate of the AHRS (default 115200)\n"
-    "  --lat DEG --lon DEG  where the antenna starts (default 48.1 N, 11.6 E: a field north of Munich)\n"
-    "  --height M         its ellipsoidal height (default 520)\n"
-    "  --geoid M          geoid separation GGA reports (default 47)\n"
-    "  --heading DEG      the tractor's compass heading (default 60)\n"
-    "  --speed MPS        it drives straight along the heading at this speed (default 0: standing)\n"
-    "  --fine-start TICKS the AHRS's SampleTimeFine at start (default 3600000000: wraps after about 7 min)\n"
-    "  --duration S       stop after S seconds (default 0: run until killed)\n"
-    "Exit codes: 0 stopped, 1 a pty failed, 2 bad command line.\n";
+    "                               [--duration S]";
+
+constexpr const char* kAbout =
+    "The tractor's navigation sensors, live, each on its own pseudo-terminal: an RTK GNSS receiver (NMEA GGA,\n"
+    "RMC, HDT on the UTC grid of its rate) and an Xsens MTi (MTData2: PacketCounter, SampleTimeFine, Euler\n"
+    "angles ENU), at the line rate of their baud. Prints \"gnss PATH\" and \"ahrs PATH\" on stdout, then sends\n"
+    "until killed or --duration is over; bytes nobody reads are lost, as on a real serial line.";
+
+constexpr const char* kFooter = "Exit codes: 0 stopped, 1 a pty failed, 2 bad command line.";
 
 // Bytes waiting unread on a pty before they count as lost: under the line discipline's 4096-byte buffer, which
 // FIONREAD cannot see past (beyond it a write would block).
@@ -280,34 +276,55 @@ void run_ahrs(const Settings& s, const Pty& pty, Counts& c) {
 
 int main(int argc, char** argv) {
   Settings s;
-  fieldguard::tools::Options opt(argc, argv, "fieldguard-nav-emulator", kUsage);
-  while (opt.next()) {
-    if (opt.is("--gnss-link")) s.gnss_link = opt.text();
-    else if (opt.is("--ahrs-link")) s.ahrs_link = opt.text();
-    else if (opt.is("--gnss-rate")) s.gnss_rate_hz = opt.number(0.1, 100.0);
-    else if (opt.is("--ahrs-rate")) s.ahrs_rate_hz = opt.number(1.0, 2000.0);
-    else if (opt.is("--gnss-baud")) s.gnss_baud = opt.integer(300, 4'000'000);
-    else if (opt.is("--ahrs-baud")) s.ahrs_baud = opt.integer(300, 4'000'000);
-    else if (opt.is("--lat")) s.lat_deg = opt.number(-89.0, 89.0);
-    else if (opt.is("--lon")) s.lon_deg = opt.number(-180.0, 180.0);
-    else if (opt.is("--height")) s.h_m = opt.number(-1000.0, 10000.0);
-    else if (opt.is("--geoid")) s.geoid_m = opt.number(-150.0, 150.0);
-    else if (opt.is("--heading")) s.heading_deg = opt.number(0.0, 360.0);
-    else if (opt.is("--speed")) s.speed_mps = opt.number(0.0, 20.0);
-    else if (opt.is("--fine-start")) s.fine_start = static_cast<std::uint32_t>(opt.integer(0, 4'294'967'295L));
-    else if (opt.is("--duration")) s.duration_s = opt.number(0.0, 1e7);
-    else opt.unknown();
-  }
+  cli::Tool tool("fieldguard-nav-emulator", kSynopsis, kAbout, kFooter);
+  CLI::App& app = tool.app();
+  fieldguard::tools::add_link(app, "--gnss-link", s.gnss_link, "the GNSS pty's slave device");
+  fieldguard::tools::add_link(app, "--ahrs-link", s.ahrs_link, "the AHRS pty's slave device");
+  cli::number(app, "--gnss-rate", s.gnss_rate_hz, cli::Between<double>{0.1, 100.0},
+              "NMEA epochs (GGA, RMC, HDT) a second, on the UTC grid (default 10)")
+      ->type_name("HZ");
+  cli::number(app, "--ahrs-rate", s.ahrs_rate_hz, cli::Between<double>{1.0, 2000.0},
+              "MTData2 messages a second (default 100)")
+      ->type_name("HZ");
+  const cli::Between<long> baud{300, fieldguard::tools::kMaxBaud};
+  cli::number(app, "--gnss-baud", s.gnss_baud, baud, "line rate of the GNSS (default 115200); the epochs must fit in it")
+      ->type_name("N");
+  cli::number(app, "--ahrs-baud", s.ahrs_baud, baud, "line rate of the AHRS (default 115200)")->type_name("N");
+  cli::number(app, "--lat", s.lat_deg, cli::Between<double>{-89.0, 89.0},
+              "latitude where the antenna starts (default 48.1 N: a field north of Munich)")
+      ->type_name("DEG");
+  cli::number(app, "--lon", s.lon_deg, cli::Between<double>{-180.0, 180.0},
+              "its longitude (default 11.6 E)")
+      ->type_name("DEG");
+  cli::number(app, "--height", s.h_m, cli::Between<double>{-1000.0, 10000.0}, "its ellipsoidal height (default 520)")
+      ->type_name("M");
+  cli::number(app, "--geoid", s.geoid_m, cli::Between<double>{-150.0, 150.0},
+              "geoid separation GGA reports (default 47)")
+      ->type_name("M");
+  cli::number(app, "--heading", s.heading_deg, cli::Between<double>{0.0, 360.0},
+              "the tractor's compass heading (default 60)")
+      ->type_name("DEG");
+  cli::number(app, "--speed", s.speed_mps, cli::Between<double>{0.0, 20.0},
+              "it drives straight along the heading at this speed (default 0: standing)")
+      ->type_name("MPS");
+  cli::number(app, "--fine-start", s.fine_start, cli::Between<std::uint32_t>{0, 4'294'967'295U},
+              "the AHRS's SampleTimeFine at start (default 3600000000: wraps after about 7 min)")
+      ->type_name("TICKS");
+  cli::number(app, "--duration", s.duration_s, cli::Between<double>{0.0, 1e7},
+              "stop after S seconds (default 0: run until killed)")
+      ->type_name("S");
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
+
   // A sensor configured for more than its line carries would fall ever further behind: refuse it.
   const double gnss_load = static_cast<double>(epoch_bytes(gnss_epoch(s, utc_now_ns(), 0.0)).size()) * s.gnss_rate_hz;
   const double ahrs_load = static_cast<double>(fieldguard::tools::mtdata2_frame(ahrs_sample(s, 0)).size()) * s.ahrs_rate_hz;
   if (gnss_load > 0.9 * static_cast<double>(s.gnss_baud) / 10.0) {
-    opt.fail("the GNSS epochs need " + std::to_string(static_cast<long>(gnss_load * 10.0)) +
-             " baud, more than 90 % of --gnss-baud " + std::to_string(s.gnss_baud));
+    return tool.fail("the GNSS epochs need " + std::to_string(static_cast<long>(gnss_load * 10.0)) +
+                     " baud, more than 90 % of --gnss-baud " + std::to_string(s.gnss_baud));
   }
   if (ahrs_load > 0.9 * static_cast<double>(s.ahrs_baud) / 10.0) {
-    opt.fail("the AHRS messages need " + std::to_string(static_cast<long>(ahrs_load * 10.0)) +
-             " baud, more than 90 % of --ahrs-baud " + std::to_string(s.ahrs_baud));
+    return tool.fail("the AHRS messages need " + std::to_string(static_cast<long>(ahrs_load * 10.0)) +
+                     " baud, more than 90 % of --ahrs-baud " + std::to_string(s.ahrs_baud));
   }
 
   Pty gnss;

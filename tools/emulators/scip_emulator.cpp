@@ -18,10 +18,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "cli/cli.hpp"
 #include "fieldguard/drivers/scip.hpp"
-#include "options.hpp"
 #include "scip_sensor.hpp"
 
 namespace {
@@ -29,15 +30,18 @@ namespace {
 namespace scip = fieldguard::scip;
 using Clock = std::chrono::steady_clock;
 
-constexpr const char* kUsage =
-    "usage: fieldguard-scip-emulator [--port N] [--scene wall|obstacle] [--drop-after N] [--garbage-after N]\n"
-    "                                [--refuse-laser] [--max-clients N]\n"
-    "  --port N           listen on 127.0.0.1:N (default 0: any free port; the port is printed)\n"
-    "  --scene S          wall: a wall 8 m ahead; obstacle: also a 0.6 m wide box 1.0 m in front (default)\n"
-    "  --drop-after N     after N scans of a connection, send half a scan and close it (each connection)\n"
-    "  --garbage-after N  after N scans of a connection, send 300 bytes of garbage once, then go on\n"
-    "  --refuse-laser     answer BM with status 01 (laser could not be lit)\n"
-    "  --max-clients N    exit after serving N connections (default: serve until killed)\n";
+namespace cli = fieldguard::tools::cli;
+
+constexpr const char* kSynopsis =
+    "fieldguard-scip-emulator [--port N] [--scene wall|obstacle] [--drop-after N] [--garbage-after N]\n"
+    "                                [--refuse-laser] [--max-clients N]";
+
+constexpr const char* kAbout =
+    "A TCP server that answers like a Hokuyo UTM-30LX-EW speaking SCIP 2.0: MD/ME scans at 40 Hz of a simple\n"
+    "scene, and misbehaviour on request. Prints the listening port on stdout, one line. Serves one client at\n"
+    "a time, any number in turn, until --max-clients or a signal.";
+
+constexpr const char* kFooter = "Exit codes: 0 served --max-clients; 2 bad command line, or the port cannot be opened.";
 
 struct Options {
   int port = 0;
@@ -134,19 +138,31 @@ void serve(int fd, const Options& o) {
 
 int main(int argc, char** argv) {
   Options o;
-  fieldguard::tools::Options opt(argc, argv, "fieldguard-scip-emulator", kUsage);
-  while (opt.next()) {
-    if (opt.is("--port")) o.port = static_cast<int>(opt.integer(0, 65535));
-    else if (opt.is("--scene")) {
-      const std::string scene = opt.text();
-      if (scene != "wall" && scene != "obstacle") opt.fail("--scene is wall or obstacle, not '" + scene + "'");
-      o.obstacle = scene == "obstacle";
-    } else if (opt.is("--drop-after")) o.drop_after = opt.integer(-1, 1'000'000'000);
-    else if (opt.is("--garbage-after")) o.garbage_after = opt.integer(-1, 1'000'000'000);
-    else if (opt.is("--refuse-laser")) o.refuse_laser = true;
-    else if (opt.is("--max-clients")) o.max_clients = opt.integer(-1, 1'000'000'000);
-    else opt.unknown();
-  }
+  cli::Tool tool("fieldguard-scip-emulator", kSynopsis, kAbout, kFooter);
+  CLI::App& app = tool.app();
+  cli::number(app, "--port", o.port, cli::Between<int>{0, 65535},
+              "listen on 127.0.0.1:N (default 0: any free port; the port is printed)")
+      ->type_name("N");
+  cli::checked(
+      app, "--scene", o.obstacle,
+      [](std::string_view s, bool& obstacle) {
+        obstacle = s == "obstacle";
+        return obstacle || s == "wall";
+      },
+      [](bool /*obstacle*/) { return true; }, "wall or obstacle",
+      "wall: a wall 8 m ahead; obstacle: also a 0.6 m wide box 1.0 m in front (default)")
+      ->type_name("S");
+  const cli::Between<long> scans{-1, 1'000'000'000};
+  cli::number(app, "--drop-after", o.drop_after, scans,
+              "after N scans of a connection, send half a scan and close it (each connection;\n-1, the default: never)")
+      ->type_name("N");
+  cli::number(app, "--garbage-after", o.garbage_after, scans,
+              "after N scans of a connection, send 300 bytes of garbage once, then go on\n(-1, the default: never)")
+      ->type_name("N");
+  app.add_flag("--refuse-laser", o.refuse_laser, "answer BM with status 01 (laser could not be lit)");
+  cli::number(app, "--max-clients", o.max_clients, scans, "exit after serving N connections (default: serve until killed)")
+      ->type_name("N");
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
   const int srv = ::socket(AF_INET, SOCK_STREAM, 0);
   const int on = 1;
   ::setsockopt(srv, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);

@@ -20,21 +20,24 @@
 #include <thread>
 #include <vector>
 
-#include "options.hpp"
+#include "emulator_cli.hpp"
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: fieldguard-serial-emulator --file FILE [--baud N] [--loop N] [--chunk BYTES] [--link PATH]\n"
-    "                                  [--hold-open SECONDS] [--garbage-every N]\n"
-    "  --file FILE        bytes to play (an NMEA log, an Xsens MTData2 capture, ...)\n"
-    "  --baud N           pace at N/10 bytes per second (default 115200); 0 = as fast as the pty takes them\n"
-    "  --loop N           play the file N times (default 1)\n"
-    "  --chunk BYTES      bytes per write (default 64)\n"
-    "  --link PATH        also make PATH a symlink to the slave device (like /dev/serial/by-id/...)\n"
-    "  --hold-open S      keep the pty open S seconds after the last byte (default 1), then close it:\n"
-    "                     the reader sees the device disappear\n"
-    "  --garbage-every N  after every N chunks write 7 bytes of line noise (default 0 = never)\n";
+namespace cli = fieldguard::tools::cli;
+
+constexpr const char* kSynopsis =
+    "fieldguard-serial-emulator --file FILE [--baud N] [--loop N] [--chunk BYTES] [--link PATH]\n"
+    "                                  [--hold-open SECONDS] [--garbage-every N]";
+
+constexpr const char* kAbout =
+    "Plays a recorded byte stream into a pseudo-terminal, paced at the line rate of --baud (8N1: baud / 10\n"
+    "bytes a second), so a serial reader can be tested against a real tty. Prints the slave device path (or\n"
+    "--link) on stdout, one line, then plays. The slave side is raw and held open: bytes written before the\n"
+    "reader opens it wait in the pty unchanged.";
+
+constexpr const char* kFooter =
+    "Exit codes: 0 played; 2 bad command line, unreadable file, or the pty failed.";
 
 int fail(const std::string& what) {
   std::fprintf(stderr, "fieldguard-serial-emulator: %s\n", what.c_str());
@@ -51,18 +54,25 @@ int main(int argc, char** argv) {
   unsigned long chunk = 64;
   unsigned long garbage_every = 0;
   double hold_open_s = 1.0;
-  fieldguard::tools::Options opt(argc, argv, "fieldguard-serial-emulator", kUsage);
-  while (opt.next()) {
-    if (opt.is("--file")) file = opt.text();
-    else if (opt.is("--baud")) baud = static_cast<unsigned long>(opt.integer(0, 4'000'000));
-    else if (opt.is("--loop")) loops = static_cast<unsigned long>(opt.integer(1, 1'000'000));
-    else if (opt.is("--chunk")) chunk = static_cast<unsigned long>(opt.integer(1, 1 << 20));
-    else if (opt.is("--link")) link = opt.text();
-    else if (opt.is("--hold-open")) hold_open_s = opt.number(0.0, 86400.0);
-    else if (opt.is("--garbage-every")) garbage_every = static_cast<unsigned long>(opt.integer(0, 1'000'000'000));
-    else opt.unknown();
-  }
-  if (file.empty()) return fail("--file is required");
+  cli::Tool tool("fieldguard-serial-emulator", kSynopsis, kAbout, kFooter);
+  CLI::App& app = tool.app();
+  app.add_option("--file", file, "bytes to play (an NMEA log, an Xsens MTData2 capture, ...)")->type_name("FILE");
+  cli::number(app, "--baud", baud, cli::Between<unsigned long>{0, fieldguard::tools::kMaxBaud},
+              "pace at N/10 bytes per second (default 115200); 0 = as fast as the pty takes them")
+      ->type_name("N");
+  fieldguard::tools::add_loop(app, loops, "the file");
+  cli::number(app, "--chunk", chunk, cli::Between<unsigned long>{1, 1 << 20}, "bytes per write (default 64)")
+      ->type_name("BYTES");
+  fieldguard::tools::add_link(app, "--link", link, "the slave device (printed in its place)");
+  cli::number(app, "--hold-open", hold_open_s, cli::Between<double>{0.0, 86400.0},
+              "keep the pty open S seconds after the last byte (default 1), then close it:\n"
+              "the reader sees the device disappear")
+      ->type_name("S");
+  cli::number(app, "--garbage-every", garbage_every, cli::Between<unsigned long>{0, 1'000'000'000},
+              "after every N chunks write 7 bytes of line noise (default 0 = never)")
+      ->type_name("N");
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
+  if (file.empty()) return tool.fail("--file is required");
   std::ifstream in(file, std::ios::binary);
   if (!in) return fail("cannot read " + file);
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

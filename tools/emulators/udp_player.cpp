@@ -19,27 +19,40 @@
 #include <cstring>
 #include <map>
 #include <string>
+#include <string_view>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "emulator_cli.hpp"
 #include "fieldguard/io/pcap_reader.hpp"
-#include "options.hpp"
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: fieldguard-udp-player --pcap FILE [--host ADDR] [--map FROM:TO]... [--speed X] [--loop N]\n"
-    "                             [--delay SECONDS] [--live-time]\n"
-    "  --pcap FILE       the capture to play (pcap or pcapng; every UDP datagram in it)\n"
-    "  --host ADDR       IPv4 address to send to (default 127.0.0.1)\n"
-    "  --map FROM:TO     send datagrams captured on port FROM to port TO (default: the captured port);\n"
-    "                    datagrams on ports no --map names are skipped once any --map is given\n"
-    "  --speed X         1 = the capture's pace (default), 2 = twice as fast, 0 = as fast as possible\n"
-    "  --loop N          play the capture N times, each after the previous (default 1)\n"
-    "  --delay SECONDS   wait this long after printing the count before the first datagram (default 0)\n"
-    "  --live-time       rewrite the timestamp of every 1206-byte data packet (u32 LE at byte 1200) to the\n"
-    "                    host's UTC wall clock in microseconds past the hour when it is sent\n"
-    "Exit codes: 0 played, 1 a send failed, 2 bad command line or unreadable capture.\n";
+namespace cli = fieldguard::tools::cli;
+
+constexpr const char* kSynopsis =
+    "fieldguard-udp-player --pcap FILE [--host ADDR] [--map FROM:TO]... [--speed X] [--loop N]\n"
+    "                             [--delay SECONDS] [--live-time]";
+
+constexpr const char* kAbout =
+    "Plays the UDP datagrams of a capture to a host over real UDP sockets, paced by the capture's record\n"
+    "times: a LiDAR on the bench. Prints \"playing N datagrams\" on stdout once the capture is read, then\n"
+    "plays, and exits when the capture (and its loops) ends; SIGTERM or SIGINT stops it early. A summary goes\n"
+    "to stderr either way.";
+
+constexpr const char* kFooter = "Exit codes: 0 played, 1 a send failed, 2 bad command line or unreadable capture.";
+
+// "FROM:TO": a captured port (0..65535) and the port to send to (1..65535).
+bool parse_map(std::string_view text, std::pair<std::uint16_t, std::uint16_t>& out) {
+  const std::string m(text);
+  unsigned from = 0;
+  unsigned to = 0;
+  char tail = 0;
+  if (std::sscanf(m.c_str(), "%u:%u%c", &from, &to, &tail) != 2 || from > 65535 || to == 0 || to > 65535) return false;
+  out = {static_cast<std::uint16_t>(from), static_cast<std::uint16_t>(to)};
+  return true;
+}
 
 // The HDL-32E data packet and its timestamp field (protocols.md §1: u32 LE, µs past the top of the UTC hour).
 constexpr std::size_t kDataPacketSize = 1206;
@@ -72,37 +85,43 @@ int main(int argc, char** argv) {
   long loops = 1;
   double delay_s = 0.0;
   bool live_time = false;
-  fieldguard::tools::Options opt(argc, argv, "fieldguard-udp-player", kUsage);
-  while (opt.next()) {
-    if (opt.is("--pcap")) {
-      pcap = opt.text();
-    } else if (opt.is("--host")) {
-      host = opt.text();
-    } else if (opt.is("--map")) {
-      const std::string m = opt.text();
-      unsigned from = 0;
-      unsigned to = 0;
-      char tail = 0;
-      if (std::sscanf(m.c_str(), "%u:%u%c", &from, &to, &tail) != 2 || from > 65535 || to == 0 || to > 65535) {
-        opt.fail("--map takes FROM:TO ports, not '" + m + "'");
-      }
-      map[static_cast<std::uint16_t>(from)] = static_cast<std::uint16_t>(to);
-    } else if (opt.is("--speed")) {
-      speed = opt.number(0.0, 1000.0);
-    } else if (opt.is("--loop")) {
-      loops = opt.integer(1, 1'000'000);
-    } else if (opt.is("--delay")) {
-      delay_s = opt.number(0.0, 3600.0);
-    } else if (opt.is("--live-time")) {
-      live_time = true;
-    } else {
-      opt.unknown();
-    }
+  cli::Tool tool("fieldguard-udp-player", kSynopsis, kAbout, kFooter);
+  CLI::App& app = tool.app();
+  app.add_option("--pcap", pcap, "the capture to play (pcap or pcapng; every UDP datagram in it)")->type_name("FILE");
+  app.add_option("--host", host, "IPv4 address to send to (default 127.0.0.1)")->type_name("ADDR");
+  // Each --map adds one pair; the validator holds every one to FROM:TO.
+  std::vector<std::string> maps;
+  app.add_option("--map", maps,
+                 "send datagrams captured on port FROM to port TO (default: the captured port);\n"
+                 "datagrams on ports no --map names are skipped once any --map is given")
+      ->type_name("FROM:TO")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            std::pair<std::uint16_t, std::uint16_t> m;
+            return parse_map(text, m) ? "" : "wants FROM:TO ports (FROM 0..65535, TO 1..65535), not '" + text + "'";
+          },
+          ""));
+  cli::number(app, "--speed", speed, cli::Between<double>{0.0, 1000.0},
+              "1 = the capture's pace (default), 2 = twice as fast, 0 = as fast as possible")
+      ->type_name("X");
+  fieldguard::tools::add_loop(app, loops, "the capture");
+  cli::number(app, "--delay", delay_s, cli::Between<double>{0.0, 3600.0},
+              "wait this long after printing the count before the first datagram (default 0)")
+      ->type_name("SECONDS");
+  app.add_flag("--live-time", live_time,
+               "rewrite the timestamp of every 1206-byte data packet (u32 LE at byte 1200) to the\n"
+               "host's UTC wall clock in microseconds past the hour when it is sent");
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
+  for (const std::string& text : maps) {
+    std::pair<std::uint16_t, std::uint16_t> m;
+    if (parse_map(text, m)) map[m.first] = m.second;
   }
-  if (pcap.empty()) opt.fail("--pcap is required");
+  if (pcap.empty()) return tool.fail("--pcap is required");
   sockaddr_in to{};
   to.sin_family = AF_INET;
-  if (::inet_pton(AF_INET, host.c_str(), &to.sin_addr) != 1) opt.fail("--host takes an IPv4 address, not '" + host + "'");
+  if (::inet_pton(AF_INET, host.c_str(), &to.sin_addr) != 1) return tool.fail("--host: wants an IPv4 address, not '" + host + "'");
 
   auto reader = fieldguard::io::PcapReader::open(pcap);
   if (!reader) {

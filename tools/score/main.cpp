@@ -1,11 +1,12 @@
 // fieldguard-score: scores a replay's obstacles (JSON lines) against the simulator's ground truth.
-#include <charconv>
+#include <array>
 #include <iostream>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "cli/cli.hpp"
 #include "score/frames.hpp"
 #include "score/metrics.hpp"
 #include "score/report.hpp"
@@ -13,116 +14,87 @@
 namespace {
 
 using namespace fieldguard::score;
+namespace cli = fieldguard::tools::cli;
 
-void usage(std::ostream& os) {
-  os << "usage: fieldguard-score --detections FILE --truth FILE [--json] [--margin M] [--min-overlap F]\n"
-        "                        [--min-hits N] [--min-raised-hits N] [--region X0,Y0,X1,Y1 | --region none] [--include-partial]\n"
-        "                        [--tolerance S]\n\n"
-        "Scores obstacles (fieldguard replay --obstacles-out: one JSON line per rotation with \"stamp\",\n"
-        "\"obstacles\": [{\"min\", \"max\", ...}], optionally \"partial\") against ground truth (fieldguard-sim\n"
-        "--truth). Frames are paired by stamp: nearest within --tolerance (default half the rotation period).\n\n"
-        "  --json              print one JSON object instead of the tables (layout: tools/score/report.hpp)\n"
-        "  --margin M          grow truth boxes by M metres on every side before testing overlap (default 0.3)\n"
-"  --min-overlap F     on x and y the overlap must be at least F of the shorter extent (default 0.5)\n"
-        "  --min-hits N        a real object is visible with at least N returns (default 3)\n"
-        "  --min-raised-hits N and at least N of them 0.5 m or more above the field surface under them\n"
-        "                      (default 3; the truth's \"raised_hits\"; 0: any returns count, as before)\n"
-        "  --region ...        and only if its box overlaps this x-y rectangle (default -10,-10,50,10: the\n"
-        "                      configured region of interest); 'none' for everywhere\n"
-        "  --include-partial   also score detection frames marked \"partial\": true (skipped by default)\n"
-        "  --tolerance S       largest stamp difference of paired frames, seconds\n\n"
-        "Definitions (tools/score/metrics.hpp): an obstacle matches a truth item when their boxes overlap on\n"
-        "x, y and z after the item's box is grown by the margin, on x and y by at least --min-overlap of the\n"
-        "shorter of the two extents (+5 cm each; no slivers). Detected = visible object with a matching\n"
-        "obstacle. False obstacle = matches no real object (visible or not); the ground false-detection rate\n"
-        "of a 5 m band = frames with a false obstacle at that distance / scored frames. Crown TP = exactly one\n"
-        "obstacle matches the crown and it matches no other visible object; missed = none matches; split =\n"
-        "two or more; merged = its one obstacle also matches another visible object. Over-segmentation =\n"
-        "(frame, object) matched by >= 2 obstacles; under-segmentation = (frame, obstacle) matching >= 2\n"
-        "visible objects.\n\n"
-        "Exit codes: 0 scored; 2 unusable input (missing file, bad JSON line: named with its line) or bad\n"
-        "command line.\n";
-}
+constexpr const char* kSynopsis =
+    "fieldguard-score --detections FILE --truth FILE [--json] [--margin M] [--min-overlap F]\n"
+    "                        [--min-hits N] [--min-raised-hits N] [--region X0,Y0,X1,Y1 | --region none] [--include-partial]\n"
+    "                        [--tolerance S]";
 
-int bad_usage(const std::string& msg) {
-  std::cerr << "fieldguard-score: " << msg << "\n(fieldguard-score --help lists the options)\n";
-  return 2;
-}
+constexpr const char* kAbout =
+    "Scores obstacles (fieldguard replay --obstacles-out: one JSON line per rotation with \"stamp\",\n"
+    "\"obstacles\": [{\"min\", \"max\", ...}], optionally \"partial\") against ground truth (fieldguard-sim\n"
+    "--truth). Frames are paired by stamp: nearest within --tolerance (default half the rotation period).";
 
-template <typename T>
-bool parse_number(std::string_view s, T& out) {
-  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc{} && ptr == s.data() + s.size();
-}
+constexpr const char* kFooter =
+    "Definitions (tools/score/metrics.hpp): an obstacle matches a truth item when their boxes overlap on\n"
+    "x, y and z after the item's box is grown by the margin, on x and y by at least --min-overlap of the\n"
+    "shorter of the two extents (+5 cm each; no slivers). Detected = visible object with a matching\n"
+    "obstacle. False obstacle = matches no real object (visible or not); the ground false-detection rate\n"
+    "of a 5 m band = frames with a false obstacle at that distance / scored frames. Crown TP = exactly one\n"
+    "obstacle matches the crown and it matches no other visible object; missed = none matches; split =\n"
+    "two or more; merged = its one obstacle also matches another visible object. Over-segmentation =\n"
+    "(frame, object) matched by >= 2 obstacles; under-segmentation = (frame, obstacle) matching >= 2\n"
+    "visible objects.\n\n"
+    "Exit codes: 0 scored; 2 unusable input (missing file, bad JSON line: named with its line) or bad\n"
+    "command line.";
 
-bool parse_region(std::string_view s, std::array<double, 4>& out) {
+// "X0,Y0,X1,Y1" with X0 < X1 and Y0 < Y1, or "none" (no region: everywhere).
+bool parse_region(std::string_view s, std::optional<std::array<double, 4>>& out) {
+  if (s == "none") {
+    out.reset();
+    return true;
+  }
+  std::array<double, 4> r{};
   for (std::size_t i = 0; i < 4; ++i) {
     const std::size_t comma = s.find(',');
     const std::string_view part = i < 3 ? s.substr(0, comma) : s;
-    if ((i < 3 && comma == std::string_view::npos) || !parse_number(part, out[i])) return false;
+    if ((i < 3 && comma == std::string_view::npos) || !cli::parse_number(part, r[i])) return false;
     if (i < 3) s.remove_prefix(comma + 1);
   }
-  return out[0] < out[2] && out[1] < out[3];
+  if (!(r[0] < r[2] && r[1] < r[3])) return false;
+  out = r;
+  return true;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string_view> args(argv + 1, argv + argc);
   std::string detections_path;
   std::string truth_path;
   bool json = false;
   ScoreParams params;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string_view a = args[i];
-    if (a == "--help" || a == "-h") {
-      usage(std::cout);
-      return 0;
-    }
-    if (a == "--json") {
-      json = true;
-      continue;
-    }
-    if (a == "--include-partial") {
-      params.include_partial = true;
-      continue;
-    }
-    if (i + 1 >= args.size()) return bad_usage(std::string(a) + (a.starts_with("--") ? " needs a value" : ": unknown argument"));
-    const std::string_view v = args[++i];
-    const std::string vs(v);
-    if (a == "--detections") {
-      detections_path = vs;
-    } else if (a == "--truth") {
-      truth_path = vs;
-    } else if (a == "--margin") {
-      if (!parse_number(v, params.margin_m) || params.margin_m < 0.0) return bad_usage("--margin wants metres >= 0, not '" + vs + "'");
-    } else if (a == "--min-overlap") {
-      if (!parse_number(v, params.min_overlap) || params.min_overlap < 0.0 || params.min_overlap > 1.0) {
-        return bad_usage("--min-overlap wants a fraction from 0 to 1, not '" + vs + "'");
-      }
-    } else if (a == "--min-hits") {
-      if (!parse_number(v, params.min_hits) || params.min_hits < 1) return bad_usage("--min-hits wants a whole number >= 1, not '" + vs + "'");
-    } else if (a == "--min-raised-hits") {
-      if (!parse_number(v, params.min_raised_hits) || params.min_raised_hits < 0) {
-        return bad_usage("--min-raised-hits wants a whole number >= 0, not '" + vs + "'");
-      }
-    } else if (a == "--region") {
-      if (v == "none") {
-        params.region.reset();
-      } else {
-        std::array<double, 4> r{};
-        if (!parse_region(v, r)) return bad_usage("--region wants X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1 (metres), or none; not '" + vs + "'");
-        params.region = r;
-      }
-    } else if (a == "--tolerance") {
-      double t = 0.0;
-      if (!parse_number(v, t) || t <= 0.0) return bad_usage("--tolerance wants seconds > 0, not '" + vs + "'");
-      params.tolerance_s = t;
-    } else {
-      return bad_usage("unknown option '" + std::string(a) + "'");
-    }
-  }
-  if (detections_path.empty() || truth_path.empty()) return bad_usage("--detections FILE and --truth FILE are required");
+  cli::Tool tool("fieldguard-score", kSynopsis, kAbout, kFooter, "(fieldguard-score --help lists the options)");
+  CLI::App& app = tool.app();
+  app.add_option("--detections", detections_path, "obstacles to score (fieldguard replay --obstacles-out)")
+      ->type_name("FILE");
+  app.add_option("--truth", truth_path, "ground truth (fieldguard-sim --truth)")->type_name("FILE");
+  app.add_flag("--json", json, "print one JSON object instead of the tables (layout: tools/score/report.hpp)");
+  cli::number(app, "--margin", params.margin_m, [](double m) { return m >= 0.0; }, "metres >= 0",
+              "grow truth boxes by M metres on every side before testing overlap (default 0.3)")
+      ->type_name("M");
+  cli::number(app, "--min-overlap", params.min_overlap, cli::Between<double>{0.0, 1.0}, "a fraction from 0 to 1",
+              "on x and y the overlap must be at least F of the shorter extent (default 0.5)")
+      ->type_name("F");
+  cli::number(app, "--min-hits", params.min_hits, [](long n) { return n >= 1; }, "a whole number >= 1",
+              "a real object is visible with at least N returns (default 3)")
+      ->type_name("N");
+  cli::number(app, "--min-raised-hits", params.min_raised_hits, [](long n) { return n >= 0; }, "a whole number >= 0",
+              "and at least N of them 0.5 m or more above the field surface under them\n"
+              "(default 3; the truth's \"raised_hits\"; 0: any returns count, as before)")
+      ->type_name("N");
+  cli::checked(app, "--region", params.region, parse_region, [](const auto& /*region*/) { return true; },
+               "X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1 (metres), or none",
+               "and only if its box overlaps this x-y rectangle (default -10,-10,50,10: the\n"
+               "configured region of interest); 'none' for everywhere")
+      ->type_name("X0,Y0,X1,Y1|none");
+  app.add_flag("--include-partial", params.include_partial,
+               "also score detection frames marked \"partial\": true (skipped by default)");
+  cli::number(app, "--tolerance", params.tolerance_s, [](double t) { return t > 0.0; }, "seconds > 0",
+              "largest stamp difference of paired frames, seconds")
+      ->type_name("S");
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
+  if (detections_path.empty() || truth_path.empty()) return tool.fail("--detections FILE and --truth FILE are required");
 
   std::vector<TruthFrame> truth;
   std::vector<DetectionFrame> detections;

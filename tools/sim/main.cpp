@@ -1,6 +1,5 @@
 // fieldguard-sim: writes an HDL-32E capture (classic pcap) of a simulated scene and its ground truth (JSONL).
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cli/cli.hpp"
 #include "sim/hdl32e.hpp"
 #include "sim/pcap_writer.hpp"
 #include "sim/scenes.hpp"
@@ -22,45 +22,31 @@
 namespace {
 
 using namespace fieldguard::sim;
+namespace cli = fieldguard::tools::cli;
 
 constexpr std::int64_t kDefaultStartS = 1718449170;  // 2024-06-15 10:59:30 UTC: the hour turns after 30 s
 
-void usage(std::ostream& os) {
-  os << "usage: fieldguard-sim --scene NAME (--pcap FILE | --session DIR) [--truth FILE] [--rotations N]\n"
-        "                      [--rate HZ] [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
-        "                      [--antenna X,Y,Z] [--origin LAT,LON,H] [--heading DEG]\n"
-        "       fieldguard-sim --list-scenes | --help\n\n"
-        "Simulates a Velodyne HDL-32E (strongest return, 0x37/0x21, 2 mm units) 0.95 m above a field at the\n"
-        "front of a tractor and writes its data packets as a classic pcap (Ethernet/IPv4/UDP to port 2368,\n"
-        "record time = packet time = its last firing) plus one ground-truth JSON line per rotation.\n\n"
-        "  --scene NAME        one of the scenes below\n"
-        "  --pcap FILE         capture to write\n"
-        "  --session DIR       also write the other sensors as `fieldguard record` does: DIR/lidar.pcap (unless\n"
-        "                      --pcap), DIR/gnss.log (NMEA GGA, RMC, HDT at 10 Hz, RTK noise), DIR/ahrs.log (Xsens\n"
-        "                      MTData2 at 100 Hz: counter, SampleTimeFine, Euler ENU), DIR/scan2d.log (SCIP 2.0\n"
-        "                      MD session of a UTM-30LX-EW on the front bumper, 40 Hz) and DIR/pose.truth.jsonl\n"
-        "  --antenna X,Y,Z     GNSS antenna in the vehicle frame (origin on the ground below the rear axle;\n"
-        "                      default 0,0,2.8: on the cab roof)\n"
-        "  --origin LAT,LON,H  the world origin (WGS84 deg, deg, m; default 48.1,11.6,520: north of Munich)\n"
-        "  --heading DEG       compass heading of the tractor's path (default 60)\n"
-        "  --truth FILE        ground truth to write (default: FILE without .pcap + .truth.jsonl)\n"
-        "  --rotations N       rotations to simulate (default: the scene's)\n"
-        "  --rate HZ           rotation rate, 5..20 (default 10); rounded to a whole number of packets per\n"
-        "                      rotation: 10 -> 181 packets (9.991 Hz), 5 -> 362 packets (4.996 Hz)\n"
-        "  --seed N            random seed (default 1); the same seed gives byte-identical output\n"
-        "  --start-time S      Unix time of the first firing (default 1718449170 = 10:59:30 UTC, so the\n"
-        "                      packet timestamps wrap at the top of the hour after 30 s)\n"
-        "  --threads N         threads casting rays (default 1; 0 = one per hardware thread, at most 8);\n"
-        "                      the output is byte-identical for any N. Each rotation waits for all of them,\n"
-        "                      so on a busy machine more threads can be slower\n"
-        "  --quiet             no progress or summary on stderr\n\n"
-        "Every rotation starts exactly at azimuth 0 (the cut angle) with block 0 of a packet, so each one is a\n"
-        "full turn. A reader's rotation assembler may still flag the first and the last rotation of the file\n"
-        "as partial (it cannot know the first one began at the cut, and the stream ends after the last).\n\n"
-        "Scenes (default rotations in brackets):\n";
+constexpr const char* kSynopsis =
+    "fieldguard-sim --scene NAME (--pcap FILE | --session DIR) [--truth FILE] [--rotations N]\n"
+    "                      [--rate HZ] [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
+    "                      [--antenna X,Y,Z] [--origin LAT,LON,H] [--heading DEG]\n"
+    "       fieldguard-sim --list-scenes | --help";
+
+constexpr const char* kAbout =
+    "Simulates a Velodyne HDL-32E (strongest return, 0x37/0x21, 2 mm units) 0.95 m above a field at the\n"
+    "front of a tractor and writes its data packets as a classic pcap (Ethernet/IPv4/UDP to port 2368,\n"
+    "record time = packet time = its last firing) plus one ground-truth JSON line per rotation.";
+
+// What follows the options: the rotation rule, the scene catalogue (word-wrapped at 100 columns, indented
+// by 6), the truth's layout and the exit codes.
+std::string footer() {
+  std::string out =
+      "Every rotation starts exactly at azimuth 0 (the cut angle) with block 0 of a packet, so each one is a\n"
+      "full turn. A reader's rotation assembler may still flag the first and the last rotation of the file\n"
+      "as partial (it cannot know the first one began at the cut, and the stream ends after the last).\n\n"
+      "Scenes (default rotations in brackets):\n";
   for (const SceneInfo& s : scene_catalog()) {
-    os << "  " << s.name << " [" << s.default_rotations << "]\n";
-    // Word-wrapped at 100 columns, indented by 6.
+    out += "  " + std::string(s.name) + " [" + std::to_string(s.default_rotations) + "]\n";
     std::string_view text = s.summary;
     while (!text.empty()) {
       std::size_t cut = text.size();
@@ -68,19 +54,14 @@ void usage(std::ostream& os) {
         cut = text.rfind(' ', 94);
         if (cut == std::string_view::npos) cut = 94;
       }
-      os << "      " << text.substr(0, cut) << "\n";
+      out += "      " + std::string(text.substr(0, cut)) + "\n";
       text.remove_prefix(std::min(text.size(), cut + 1));
     }
   }
-  os << "\nGround truth: see tools/sim/truth_writer.hpp; boxes are in the sensor frame (x forward, y left, z up).\n"
-        "Exit codes: 0 written; 1 writing failed; 2 bad command line.\n";
-}
-
-template <typename T>
-bool parse_number(std::string_view s, T& out) {
-  const auto* end = s.data() + s.size();
-  const auto [ptr, ec] = std::from_chars(s.data(), end, out);
-  return ec == std::errc{} && ptr == end;
+  out +=
+      "\nGround truth: see tools/sim/truth_writer.hpp; boxes are in the sensor frame (x forward, y left, z up).\n"
+      "Exit codes: 0 written; 1 writing failed; 2 bad command line.";
+  return out;
 }
 
 struct Options {
@@ -93,98 +74,95 @@ struct Options {
   std::int64_t start_s = kDefaultStartS;
   unsigned threads = 1;
   bool quiet = false;
+  bool list_scenes = false;
   std::string session;
   Vec3 antenna{0.0, 0.0, 2.8};
   Geodetic origin{48.1, 11.6, 520.0};
   double heading_deg = 60.0;
 };
 
-// "a,b,c": exactly three numbers.
+// "a,b,c": exactly three finite numbers.
 bool parse_triple(std::string_view s, double& a, double& b, double& c) {
   const std::size_t p1 = s.find(',');
   const std::size_t p2 = p1 == std::string_view::npos ? p1 : s.find(',', p1 + 1);
   if (p2 == std::string_view::npos) return false;
-  return parse_number(s.substr(0, p1), a) && parse_number(s.substr(p1 + 1, p2 - p1 - 1), b) && parse_number(s.substr(p2 + 1), c) &&
-         std::isfinite(a) && std::isfinite(b) && std::isfinite(c);
+  return cli::parse_number(s.substr(0, p1), a) && cli::parse_number(s.substr(p1 + 1, p2 - p1 - 1), b) &&
+         cli::parse_number(s.substr(p2 + 1), c) && std::isfinite(a) && std::isfinite(b) && std::isfinite(c);
 }
 
-int bad_usage(const std::string& msg) {
-  std::cerr << "fieldguard-sim: " << msg << "\n(fieldguard-sim --help lists the options and scenes)\n";
-  return 2;
+// The command line into `opt`; declares every option with its help.
+void declare(CLI::App& app, Options& opt) {
+  app.add_option("--scene", opt.scene, "one of the scenes below")->type_name("NAME");
+  app.add_option("--pcap", opt.pcap, "capture to write")->type_name("FILE");
+  app.add_option("--session", opt.session,
+                 "also write the other sensors as `fieldguard record` does: DIR/lidar.pcap (unless\n"
+                 "--pcap), DIR/gnss.log (NMEA GGA, RMC, HDT at 10 Hz, RTK noise), DIR/ahrs.log (Xsens\n"
+                 "MTData2 at 100 Hz: counter, SampleTimeFine, Euler ENU), DIR/scan2d.log (SCIP 2.0\n"
+                 "MD session of a UTM-30LX-EW on the front bumper, 40 Hz) and DIR/pose.truth.jsonl")
+      ->type_name("DIR");
+  cli::checked(
+      app, "--antenna", opt.antenna, [](std::string_view s, Vec3& v) { return parse_triple(s, v.x, v.y, v.z); },
+      [](const Vec3& v) { return std::abs(v.x) <= 20.0 && std::abs(v.y) <= 5.0 && v.z >= 0.0 && v.z <= 6.0; },
+      "X,Y,Z in metres on the tractor (|x| <= 20, |y| <= 5, 0 <= z <= 6)",
+      "GNSS antenna in the vehicle frame (origin on the ground below the rear axle;\n"
+      "default 0,0,2.8: on the cab roof)")
+      ->type_name("X,Y,Z");
+  cli::checked(
+      app, "--origin", opt.origin,
+      [](std::string_view s, Geodetic& g) { return parse_triple(s, g.lat_deg, g.lon_deg, g.h_m); },
+      [](const Geodetic& g) {
+        return std::abs(g.lat_deg) <= 85.0 && std::abs(g.lon_deg) <= 180.0 && std::abs(g.h_m) <= 9000.0;
+      },
+      "LAT,LON,H (|lat| <= 85 deg, |lon| <= 180 deg, |h| <= 9000 m)",
+      "the world origin (WGS84 deg, deg, m; default 48.1,11.6,520: north of Munich)")
+      ->type_name("LAT,LON,H");
+  cli::number(app, "--heading", opt.heading_deg, [](double d) { return d >= 0.0 && d < 360.0; },
+              "degrees from 0 to under 360 (clockwise from north)",
+              "compass heading of the tractor's path (default 60)")
+      ->type_name("DEG");
+  app.add_option("--truth", opt.truth, "ground truth to write (default: FILE without .pcap + .truth.jsonl)")
+      ->type_name("FILE");
+  cli::number(app, "--rotations", opt.rotations, [](int n) { return n >= 1; }, "a whole number >= 1",
+              "rotations to simulate (default: the scene's)")
+      ->type_name("N");
+  cli::number(app, "--rate", opt.rate_hz, cli::Between<double>{5.0, 20.0},
+              "a number of Hz from 5 to 20 (the HDL-32E's range)",
+              "rotation rate, 5..20 (default 10); rounded to a whole number of packets per\n"
+              "rotation: 10 -> 181 packets (9.991 Hz), 5 -> 362 packets (4.996 Hz)")
+      ->type_name("HZ");
+  cli::number(app, "--seed", opt.seed, [](std::uint64_t /*seed*/) { return true; }, "a whole number >= 0",
+              "random seed (default 1); the same seed gives byte-identical output")
+      ->type_name("N");
+  cli::number(app, "--start-time", opt.start_s, [](std::int64_t t) { return t >= 0; },
+              "Unix seconds (a whole number >= 0)",
+              "Unix time of the first firing (default 1718449170 = 10:59:30 UTC, so the\n"
+              "packet timestamps wrap at the top of the hour after 30 s)")
+      ->type_name("S");
+  cli::number(app, "--threads", opt.threads, cli::Between<unsigned>{0, 64},
+              "threads casting rays (default 1; 0 = one per hardware thread, at most 8);\n"
+              "the output is byte-identical for any N. Each rotation waits for all of them,\n"
+              "so on a busy machine more threads can be slower")
+      ->type_name("N");
+  app.add_flag("--quiet", opt.quiet, "no progress or summary on stderr");
+  app.add_flag("--list-scenes", opt.list_scenes, "print the scenes' names, one a line, and exit");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string_view> args(argv + 1, argv + argc);
   Options opt;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string_view a = args[i];
-    auto value = [&]() -> std::optional<std::string_view> {
-      if (i + 1 >= args.size()) return std::nullopt;
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      usage(std::cout);
-      return 0;
-    }
-    if (a == "--list-scenes") {
-      for (const SceneInfo& s : scene_catalog()) std::cout << s.name << "\n";
-      return 0;
-    }
-    if (a == "--quiet") {
-      opt.quiet = true;
-      continue;
-    }
-    const auto v = value();
-    if (!v) return bad_usage(std::string(a) + " needs a value");
-    if (a == "--scene") {
-      opt.scene = *v;
-    } else if (a == "--pcap") {
-      opt.pcap = *v;
-    } else if (a == "--session") {
-      opt.session = *v;
-    } else if (a == "--antenna") {
-      if (!parse_triple(*v, opt.antenna.x, opt.antenna.y, opt.antenna.z) || std::abs(opt.antenna.x) > 20.0 ||
-          std::abs(opt.antenna.y) > 5.0 || opt.antenna.z < 0.0 || opt.antenna.z > 6.0) {
-        return bad_usage("--antenna wants X,Y,Z in metres on the tractor (|x| <= 20, |y| <= 5, 0 <= z <= 6), not '" + std::string(*v) + "'");
-      }
-    } else if (a == "--origin") {
-      if (!parse_triple(*v, opt.origin.lat_deg, opt.origin.lon_deg, opt.origin.h_m) || std::abs(opt.origin.lat_deg) > 85.0 ||
-          std::abs(opt.origin.lon_deg) > 180.0 || std::abs(opt.origin.h_m) > 9000.0) {
-        return bad_usage("--origin wants LAT,LON,H (|lat| <= 85 deg, |lon| <= 180 deg, |h| <= 9000 m), not '" + std::string(*v) + "'");
-      }
-    } else if (a == "--heading") {
-      if (!parse_number(*v, opt.heading_deg) || !(opt.heading_deg >= 0.0 && opt.heading_deg < 360.0)) {
-        return bad_usage("--heading wants degrees from 0 to 360 (clockwise from north), not '" + std::string(*v) + "'");
-      }
-    } else if (a == "--truth") {
-      opt.truth = *v;
-    } else if (a == "--rotations") {
-      int n = 0;
-      if (!parse_number(*v, n) || n < 1) return bad_usage("--rotations wants a whole number >= 1, not '" + std::string(*v) + "'");
-      opt.rotations = n;
-    } else if (a == "--rate") {
-      if (!parse_number(*v, opt.rate_hz) || opt.rate_hz < 5.0 || opt.rate_hz > 20.0) {
-        return bad_usage("--rate wants a number of Hz from 5 to 20 (the HDL-32E's range), not '" + std::string(*v) + "'");
-      }
-    } else if (a == "--seed") {
-      if (!parse_number(*v, opt.seed)) return bad_usage("--seed wants a whole number >= 0, not '" + std::string(*v) + "'");
-    } else if (a == "--threads") {
-      if (!parse_number(*v, opt.threads) || opt.threads > 64) return bad_usage("--threads wants 0..64, not '" + std::string(*v) + "'");
-    } else if (a == "--start-time") {
-      if (!parse_number(*v, opt.start_s) || opt.start_s < 0) {
-        return bad_usage("--start-time wants Unix seconds, not '" + std::string(*v) + "'");
-      }
-    } else {
-      return bad_usage("unknown option '" + std::string(a) + "'");
-    }
+  cli::Tool tool("fieldguard-sim", kSynopsis, kAbout, footer(), "(fieldguard-sim --help lists the options and scenes)");
+  declare(tool.app(), opt);
+  if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
+  if (opt.list_scenes) {
+    for (const SceneInfo& s : scene_catalog()) std::cout << s.name << "\n";
+    return 0;
   }
-  if (opt.scene.empty()) return bad_usage("--scene is required (--list-scenes lists them)");
+  if (opt.scene.empty()) return tool.fail("--scene is required (--list-scenes lists them)");
   const SceneInfo* info = find_scene(opt.scene);
-  if (info == nullptr) return bad_usage("unknown scene '" + opt.scene + "' (--list-scenes lists them)");
+  if (info == nullptr) return tool.fail("unknown scene '" + opt.scene + "' (--list-scenes lists them)");
   if (opt.pcap.empty() && !opt.session.empty()) opt.pcap = opt.session + "/lidar.pcap";
-  if (opt.pcap.empty()) return bad_usage("--pcap FILE or --session DIR is required");
+  if (opt.pcap.empty()) return tool.fail("--pcap FILE or --session DIR is required");
   if (!opt.session.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(opt.session, ec);
