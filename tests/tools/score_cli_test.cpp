@@ -1,14 +1,15 @@
 // fieldguard-score on hand-written frames with known answers.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <string>
 
-#include "score/json.hpp"
 #include "tools/tools_test_support.hpp"
 
 namespace fieldguard::score {
 namespace {
 
+using Json = nlohmann::json;
 using tools_test::run;
 using tools_test::ScratchDir;
 using tools_test::write_file;
@@ -54,70 +55,72 @@ class ScoreCli : public ::testing::Test {
     write_file(dir_.file("truth.jsonl"), kTruth);
     write_file(dir_.file("det.jsonl"), kDetections);
   }
-  [[nodiscard]] JsonValue score_json(const std::string& extra = "", const std::string& detections = "det.jsonl",
-                                     const std::string& truth = "truth.jsonl") const {
+  [[nodiscard]] Json score_json(const std::string& extra = "", const std::string& detections = "det.jsonl",
+                                const std::string& truth = "truth.jsonl") const {
     const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file(detections) + " --truth " +
                                              dir_.file(truth) + extra);
     EXPECT_EQ(r.exit_code, 0) << r.errors;
-    const auto parsed = parse_json(r.output);
-    EXPECT_TRUE(parsed.value) << r.output;
-    return parsed.value.value_or(JsonValue{});
+    Json parsed = Json::parse(r.output, nullptr, /*allow_exceptions=*/false);
+    EXPECT_FALSE(parsed.is_discarded()) << r.output;
+    return parsed.is_discarded() ? Json::object() : parsed;
   }
-  static double num(const JsonValue& v, std::initializer_list<const char*> path) {
-    const JsonValue* p = &v;
+  // The number at `path`; -1 if a key is missing, -2 for null.
+  static double num(const Json& v, std::initializer_list<const char*> path) {
+    const Json* p = &v;
     for (const char* k : path) {
-      p = p->find(k);
-      if (p == nullptr) return -1.0;
+      const auto it = p->find(k);
+      if (it == p->end()) return -1.0;
+      p = &*it;
     }
-    return p->kind == JsonValue::Kind::Null ? -2.0 : p->number;
+    return p->is_null() ? -2.0 : p->get<double>();
   }
-  static const JsonValue& band(const JsonValue& v, const char* list, std::size_t i) { return v.find(list)->items.at(i); }
+  static const Json& band(const Json& v, const char* list, std::size_t i) { return v.at(list).at(i); }
   ScratchDir dir_{"score"};
 };
 
 TEST_F(ScoreCli, FramesArePairedByStamp) {
-  const JsonValue v = score_json();
+  const Json v = score_json();
   EXPECT_EQ(num(v, {"frames", "truth"}), 8);
   EXPECT_EQ(num(v, {"frames", "detections"}), 8);
   EXPECT_EQ(num(v, {"frames", "matched"}), 7);
   EXPECT_EQ(num(v, {"frames", "partial_skipped"}), 1);
   EXPECT_EQ(num(v, {"frames", "scored"}), 6);
-  const JsonValue* tu = v.find("frames")->find("truth_unmatched_lines");
-  ASSERT_EQ(tu->items.size(), 1U);
-  EXPECT_EQ(tu->items[0].number, 8);  // line 8 of the truth file: frame 6 (line 4 is blank)
-  const JsonValue* du = v.find("frames")->find("detections_unmatched_lines");
-  ASSERT_EQ(du->items.size(), 1U);
-  EXPECT_EQ(du->items[0].number, 2);
+  const Json& tu = v.at("frames").at("truth_unmatched_lines");
+  ASSERT_EQ(tu.size(), 1U);
+  EXPECT_EQ(tu[0], 8);  // line 8 of the truth file: frame 6 (line 4 is blank)
+  const Json& du = v.at("frames").at("detections_unmatched_lines");
+  ASSERT_EQ(du.size(), 1U);
+  EXPECT_EQ(du[0], 2);
   EXPECT_NEAR(num(v, {"params", "tolerance_s"}), 0.05, 1e-9);
 }
 
 TEST_F(ScoreCli, PedestrianDetectionAndMissByBand) {
-  const JsonValue v = score_json();
-  const JsonValue& b10 = band(v, "pedestrian", 2);
-  EXPECT_EQ(b10.find("band")->string, "10-15");
-  EXPECT_EQ(b10.find("visible")->number, 1);
-  EXPECT_EQ(b10.find("detected")->number, 1);
-  EXPECT_EQ(b10.find("rate")->number, 1.0);
-  const JsonValue& b25 = band(v, "pedestrian", 5);
-  EXPECT_EQ(b25.find("visible")->number, 1);
-  EXPECT_EQ(b25.find("detected")->number, 0);
-  EXPECT_EQ(band(v, "pedestrian", 0).find("rate")->kind, JsonValue::Kind::Null);
+  const Json v = score_json();
+  const Json& b10 = band(v, "pedestrian", 2);
+  EXPECT_EQ(b10.at("band"), "10-15");
+  EXPECT_EQ(b10.at("visible").get<double>(), 1);
+  EXPECT_EQ(b10.at("detected").get<double>(), 1);
+  EXPECT_EQ(b10.at("rate").get<double>(), 1.0);
+  const Json& b25 = band(v, "pedestrian", 5);
+  EXPECT_EQ(b25.at("visible").get<double>(), 1);
+  EXPECT_EQ(b25.at("detected").get<double>(), 0);
+  EXPECT_TRUE(band(v, "pedestrian", 0).at("rate").is_null());
   EXPECT_EQ(num(v, {"classes", "pedestrian", "visible"}), 2);
   EXPECT_EQ(num(v, {"classes", "pedestrian", "detected"}), 1);
   // With --min-hits 7 the 6-return pedestrian is not visible: the miss no longer counts.
-  const JsonValue w = score_json(" --min-hits 7");
-  EXPECT_EQ(band(w, "pedestrian", 5).find("visible")->number, 0);
+  const Json w = score_json(" --min-hits 7");
+  EXPECT_EQ(band(w, "pedestrian", 5).at("visible").get<double>(), 0);
 }
 
 TEST_F(ScoreCli, GroundFalseDetectionsByBand) {
-  const JsonValue v = score_json();
+  const Json v = score_json();
   for (std::size_t b = 0; b < 8; ++b) {
-    const JsonValue& g = band(v, "ground_false", b);
-    EXPECT_EQ(g.find("frames")->number, 6) << b;
+    const Json& g = band(v, "ground_false", b);
+    EXPECT_EQ(g.at("frames").get<double>(), 6) << b;
     const double expected = (b == 1 || b == 5) ? 1.0 : 0.0;  // the clod at 7 m; the obstacle at 25.7 m
-    EXPECT_EQ(g.find("false_frames")->number, expected) << b;
+    EXPECT_EQ(g.at("false_frames").get<double>(), expected) << b;
   }
-  EXPECT_NEAR(band(v, "ground_false", 1).find("rate")->number, 1.0 / 6.0, 1e-6);
+  EXPECT_NEAR(band(v, "ground_false", 1).at("rate").get<double>(), 1.0 / 6.0, 1e-6);
   EXPECT_EQ(num(v, {"obstacles", "total"}), 11);
   EXPECT_EQ(num(v, {"obstacles", "false"}), 2);
   EXPECT_EQ(num(v, {"obstacles", "false_by_cause", "clod"}), 1);
@@ -125,7 +128,7 @@ TEST_F(ScoreCli, GroundFalseDetectionsByBand) {
 }
 
 TEST_F(ScoreCli, ClassesAndSegmentation) {
-  const JsonValue v = score_json();
+  const Json v = score_json();
   EXPECT_EQ(num(v, {"classes", "implement", "rate"}), 1.0);
   EXPECT_EQ(num(v, {"classes", "haystack", "detected"}), 2);
   EXPECT_EQ(num(v, {"classes", "crown", "visible"}), 6);
@@ -135,7 +138,7 @@ TEST_F(ScoreCli, ClassesAndSegmentation) {
 }
 
 TEST_F(ScoreCli, CrownTruePositivesFalseAndMissed) {
-  const JsonValue v = score_json();
+  const Json v = score_json();
   EXPECT_EQ(num(v, {"crowns", "visible"}), 6);
   EXPECT_EQ(num(v, {"crowns", "tp"}), 2);
   EXPECT_EQ(num(v, {"crowns", "split"}), 1);
@@ -147,7 +150,7 @@ TEST_F(ScoreCli, CrownTruePositivesFalseAndMissed) {
   EXPECT_EQ(num(v, {"crowns", "false_obstacles"}), 1);
   // A and B are 0.4 m apart and A's obstacle reaches 0.15 m past A: with the 0.3 m margin alone it would also
   // match B (A merged, B split); the overlap rule does not let a 5 cm sliver count.
-  const JsonValue loose = score_json(" --min-overlap 0");
+  const Json loose = score_json(" --min-overlap 0");
   EXPECT_EQ(num(loose, {"crowns", "tp"}), 0);
 }
 
@@ -165,13 +168,13 @@ TEST_F(ScoreCli, ReturnsBelowTerrainHeightDoNotMakeAnObjectVisible) {
              R"({"frame": 0, "stamp": 200.0, "obstacles": [{"min": [20.2, -3.8, 0.5], "max": [21.8, -2.2, 1.9]}]})"
              "\n");
   const auto score = [&](const std::string& extra) { return score_json(extra, "raised.det.jsonl", "raised.truth.jsonl"); };
-  const JsonValue v = score("");
+  const Json v = score("");
   EXPECT_EQ(num(v, {"params", "min_raised_hits"}), 3);
   EXPECT_EQ(num(v, {"crowns", "visible"}), 1);
   EXPECT_EQ(num(v, {"crowns", "tp"}), 1);
   EXPECT_EQ(num(v, {"crowns", "missed"}), 0);
   EXPECT_EQ(num(v, {"classes", "pedestrian", "visible"}), -1);  // no visible pedestrian: no entry
-  const JsonValue old = score(" --min-raised-hits 0");
+  const Json old = score(" --min-raised-hits 0");
   EXPECT_EQ(num(old, {"crowns", "visible"}), 2);
   EXPECT_EQ(num(old, {"crowns", "missed"}), 1);
   EXPECT_EQ(num(old, {"classes", "pedestrian", "visible"}), 1);
@@ -202,7 +205,7 @@ TEST_F(ScoreCli, TruthWithoutRaisedHitsIsRefusedUnlessTheOldRuleIsAsked) {
 }
 
 TEST_F(ScoreCli, PartialFramesCanBeIncluded) {
-  const JsonValue v = score_json(" --include-partial");
+  const Json v = score_json(" --include-partial");
   EXPECT_EQ(num(v, {"frames", "scored"}), 7);
   EXPECT_EQ(num(v, {"obstacles", "false"}), 3);
 }

@@ -3,6 +3,7 @@
 // and held against the simulator's pose truth; the uneven-drive scene's attitude, pole and low box.
 #include <GeographicLib/LocalCartesian.hpp>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +23,6 @@
 #include "fieldguard/drivers/xsens_stream.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/io/pcap_reader.hpp"
-#include "score/json.hpp"
 #include "sim/geodesy.hpp"
 #include "sim/scenes.hpp"
 #include "sim/simulator.hpp"
@@ -37,22 +37,24 @@ constexpr double kDurationS = kRotations * 0.10009728;  // 181 packets of 552.96
 constexpr std::int64_t kStartNs = 1718449170LL * 1000000000LL;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::vector<score::JsonValue> read_jsonl(const std::string& path) {
-  std::vector<score::JsonValue> out;
+using Json = nlohmann::json;
+
+std::vector<Json> read_jsonl(const std::string& path) {
+  std::vector<Json> out;
   std::ifstream in(path);
   std::string line;
   while (std::getline(in, line)) {
-    auto r = score::parse_json(line);
-    EXPECT_TRUE(r.value.has_value()) << path << ": " << r.error.message;
-    if (r.value) out.push_back(std::move(*r.value));
+    auto v = Json::parse(line, nullptr, /*allow_exceptions=*/false);
+    EXPECT_FALSE(v.is_discarded()) << path << ": not JSON: " << line;
+    if (!v.is_discarded()) out.push_back(std::move(v));
   }
   return out;
 }
 
-double num(const score::JsonValue& v, std::string_view key) {
-  const score::JsonValue* m = v.find(key);
-  EXPECT_NE(m, nullptr) << key;
-  return m != nullptr ? m->number : kNaN;
+double num(const Json& v, std::string_view key) {
+  const auto m = v.find(key);
+  EXPECT_TRUE(m != v.end() && m->is_number()) << key;
+  return m != v.end() && m->is_number() ? m->get<double>() : kNaN;
 }
 
 std::vector<io::ByteLogRecord> read_log(const std::string& path) {
@@ -95,11 +97,11 @@ class SimSession : public ::testing::Test {
         }));
     ASSERT_FALSE(dir_->empty()) << errors;
     for (const auto& v : read_jsonl(path("pose.truth.jsonl"))) {
-      if (v.find("session") != nullptr) {
-        header_ = new score::JsonValue(*v.find("session"));
+      if (v.contains("session")) {
+        header_ = new Json(v.at("session"));
         continue;
       }
-      truth_[v.find("sensor")->string].push_back(v);
+      truth_[v.at("sensor").get<std::string>()].push_back(v);
     }
   }
   static void TearDownTestSuite() {
@@ -110,19 +112,19 @@ class SimSession : public ::testing::Test {
   static std::string path(const std::string& name) { return *dir_ + "/" + name; }
 
   static std::string* dir_;
-  static score::JsonValue* header_;
-  static std::map<std::string, std::vector<score::JsonValue>> truth_;
+  static Json* header_;
+  static std::map<std::string, std::vector<Json>> truth_;
 };
 std::string* SimSession::dir_ = nullptr;
-score::JsonValue* SimSession::header_ = nullptr;
-std::map<std::string, std::vector<score::JsonValue>> SimSession::truth_;
+Json* SimSession::header_ = nullptr;
+std::map<std::string, std::vector<Json>> SimSession::truth_;
 
 TEST_F(SimSession, WritesTheRecordLayout) {
   for (const char* f : {"lidar.pcap", "lidar.truth.jsonl", "gnss.log", "ahrs.log", "scan2d.log", "pose.truth.jsonl"}) {
     EXPECT_TRUE(std::filesystem::exists(path(f))) << f;
   }
   ASSERT_NE(header_, nullptr);
-  EXPECT_NEAR(header_->find("origin")->find("lat_deg")->number, 48.1, 1e-9);
+  EXPECT_NEAR(header_->at("origin").at("lat_deg").get<double>(), 48.1, 1e-9);
   EXPECT_EQ(truth_["gnss"].size(), static_cast<std::size_t>(std::ceil(kDurationS * 10.0)));
   EXPECT_EQ(truth_["ahrs"].size(), static_cast<std::size_t>(std::ceil(kDurationS * 100.0)));
   EXPECT_EQ(truth_["scan2d"].size(), static_cast<std::size_t>(std::ceil(kDurationS * 40.0)));
@@ -169,11 +171,11 @@ TEST_F(SimSession, GnssDecodesWithRtkNoiseAt10Hz) {
     const double latency_ms = (static_cast<double>(gga_host_ns[k]) - t_epoch_ns) * 1e-6;
     EXPECT_GT(latency_ms, 20.0);
     EXPECT_LT(latency_ms, 60.0);
-    const auto* ant = truth[k].find("antenna");
-    const double lat = num(*ant, "lat_deg");
+    const Json& ant = truth[k].at("antenna");
+    const double lat = num(ant, "lat_deg");
     north.push_back((*gga[k].lat_deg - lat) * kPi / 180.0 * 6366000.0);
-    east.push_back((*gga[k].lon_deg - num(*ant, "lon_deg")) * kPi / 180.0 * 6389000.0 * std::cos(lat * kPi / 180.0));
-    up.push_back(*gga[k].alt_m + gga[k].geoid_sep_m.value_or(kNaN) - num(*ant, "h_m"));
+    east.push_back((*gga[k].lon_deg - num(ant, "lon_deg")) * kPi / 180.0 * 6389000.0 * std::cos(lat * kPi / 180.0));
+    up.push_back(*gga[k].alt_m + gga[k].geoid_sep_m.value_or(kNaN) - num(ant, "h_m"));
     EXPECT_TRUE(rmc[k].valid);
     EXPECT_NEAR(*rmc[k].lat_deg, *gga[k].lat_deg, 1e-9);
     heading.push_back(hdt[k].heading_deg.value_or(kNaN) - num(truth[k], "heading_deg"));
@@ -312,29 +314,29 @@ TEST_F(SimSession, LowBoxInFrontIsSeenByThe2dScanNotByThe3dLidar) {
   // The last LiDAR rotation: the tractor stands, the box 1 m in front of the bumper.
   const auto frames = read_jsonl(path("lidar.truth.jsonl"));
   ASSERT_EQ(frames.size(), static_cast<std::size_t>(kRotations));
-  const score::JsonValue& last = frames.back();
-  const score::JsonValue* box = nullptr;
-  for (const auto& o : last.find("objects")->items) {
-    if (o.find("id")->string == "box-1") box = &o;
+  const Json& last = frames.back();
+  const Json* box = nullptr;
+  for (const auto& o : last.at("objects")) {
+    if (o.at("id") == "box-1") box = &o;
   }
   ASSERT_NE(box, nullptr);
-  EXPECT_EQ(box->find("class")->string, "box");
-  const auto& mn = box->find("min")->items;
-  const auto& mx = box->find("max")->items;
+  EXPECT_EQ(box->at("class"), "box");
+  const auto mn = box->at("min").get<std::vector<double>>();
+  const auto mx = box->at("max").get<std::vector<double>>();
   // Sensor frame: near face 1.0 m beyond the bumper (0.3 m ahead of the sensor; more where the tractor
   // stands nose up, as the box's bounds turn with the attitude), 0.4 m tall.
-  EXPECT_GT(mn[0].number, 1.1);
-  EXPECT_LT(mn[0].number, 1.5);
-  EXPECT_NEAR(mx[2].number - mn[2].number, 0.4, 0.06);
+  EXPECT_GT(mn[0], 1.1);
+  EXPECT_LT(mn[0], 1.5);
+  EXPECT_NEAR(mx[2] - mn[2], 0.4, 0.06);
   // Geometry: every point of the box lies below the lowest beam (-30.67 deg) at its horizontal distance.
   double far = 0.0;
-  for (const double x : {mn[0].number, mx[0].number}) {
-    for (const double y : {mn[1].number, mx[1].number}) far = std::max(far, std::hypot(x, y));
+  for (const double x : {mn[0], mx[0]}) {
+    for (const double y : {mn[1], mx[1]}) far = std::max(far, std::hypot(x, y));
   }
   const double beam_z = -far * std::tan(30.67 * kPi / 180.0);
   std::printf("low box: sensor-frame x %.3f..%.3f, top z %.3f; the lowest beam at its far corner (%.3f m) is at z %.3f\n",
-              mn[0].number, mx[0].number, mx[2].number, far, beam_z);
-  EXPECT_LT(mx[2].number, beam_z - 0.1);
+              mn[0], mx[0], mx[2], far, beam_z);
+  EXPECT_LT(mx[2], beam_z - 0.1);
   EXPECT_EQ(num(*box, "hits"), 0.0);
 
   // The decoded HDL-32E points of that rotation: none in the box (grown by 10 cm).
@@ -351,8 +353,8 @@ TEST_F(SimSession, LowBoxInFrontIsSeenByThe2dScanNotByThe3dLidar) {
     const auto x = static_cast<double>(p.x);
     const auto y = static_cast<double>(p.y);
     const auto z = static_cast<double>(p.z);
-    if (x > mn[0].number - 0.1 && x < mx[0].number + 0.1 && y > mn[1].number - 0.1 && y < mx[1].number + 0.1 &&
-        z > mn[2].number - 0.1 && z < mx[2].number + 0.1) {
+    if (x > mn[0] - 0.1 && x < mx[0] + 0.1 && y > mn[1] - 0.1 && y < mx[1] + 0.1 &&
+        z > mn[2] - 0.1 && z < mx[2] + 0.1) {
       ++in_box;
     }
     if (x > 0.0 && x < 2.5 && std::abs(y) < 1.0) ++ahead_low;
@@ -366,7 +368,7 @@ TEST_F(SimSession, LowBoxInFrontIsSeenByThe2dScanNotByThe3dLidar) {
   std::uint64_t problems = 0;
   const auto scans = decode_scans(read_log(path("scan2d.log")), host, problems);
   ASSERT_FALSE(scans.empty());
-  EXPECT_EQ(truth_["scan2d"].back().find("front_target")->string, "box-1");
+  EXPECT_EQ(truth_["scan2d"].back().at("front_target"), "box-1");
   const scip::Scan& s = scans.back();
   std::vector<double> face;
   for (int step = 500; step <= 580; ++step) {
@@ -381,11 +383,11 @@ TEST_F(SimSession, LowBoxInFrontIsSeenByThe2dScanNotByThe3dLidar) {
 
 TEST_F(SimSession, PoleIsInTheTruth) {
   bool in_header = false;
-  for (const auto& o : header_->find("objects")->items) {
-    if (o.find("id")->string == "pole-1") {
+  for (const auto& o : header_->at("objects")) {
+    if (o.at("id") == "pole-1") {
       in_header = true;
-      EXPECT_EQ(o.find("class")->string, "pole");
-      EXPECT_NEAR(o.find("world_max")->items[2].number - o.find("world_min")->items[2].number, 2.0, 0.05);
+      EXPECT_EQ(o.at("class"), "pole");
+      EXPECT_NEAR(o.at("world_max").at(2).get<double>() - o.at("world_min").at(2).get<double>(), 2.0, 0.05);
       EXPECT_NEAR(num(o, "base_lat_deg"), 48.1, 0.01);
     }
   }
@@ -393,8 +395,8 @@ TEST_F(SimSession, PoleIsInTheTruth) {
   std::size_t seen = 0;
   const auto frames = read_jsonl(path("lidar.truth.jsonl"));
   for (const auto& f : frames) {
-    for (const auto& o : f.find("objects")->items) {
-      if (o.find("id")->string == "pole-1" && num(o, "hits") >= 3) ++seen;
+    for (const auto& o : f.at("objects")) {
+      if (o.at("id") == "pole-1" && num(o, "hits") >= 3) ++seen;
     }
   }
   EXPECT_GT(seen, frames.size() * 9 / 10);

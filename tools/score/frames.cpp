@@ -5,8 +5,11 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <set>
+#include <string_view>
 
-#include "score/json.hpp"
+#include <nlohmann/json.hpp>
 
 namespace fieldguard::score {
 
@@ -31,6 +34,39 @@ bool matches(const Box& obstacle, const Box& truth, double margin, double min_fr
 
 namespace {
 
+using Json = nlohmann::json;
+
+// One line as one JSON value. A key repeated in an object keeps its first value, as the scorer's readers always
+// have (RFC 8259 leaves it open; nlohmann would keep the last): the parser's callback drops the repeats,
+// remembering the keys of each open object by its depth (an object's start clears its level).
+Json parse_line(const std::string& text) {
+  std::vector<std::set<std::string, std::less<>>> keys;
+  const auto first_key_wins = [&keys](int depth, Json::parse_event_t event, Json& parsed) {
+    const auto level = static_cast<std::size_t>(depth);
+    if (event == Json::parse_event_t::object_start) {
+      keys.resize(std::max(keys.size(), level + 2));
+      keys[level + 1].clear();
+    } else if (event == Json::parse_event_t::key) {
+      keys.resize(std::max(keys.size(), level + 1));
+      return keys[level].insert(parsed.get<std::string>()).second;
+    }
+    return true;
+  };
+  return Json::parse(text, first_key_wins);
+}
+
+// nlohmann's message without its "[json.exception.parse_error.101] parse error at line 1, column 7: " head.
+std::string json_message(const Json::exception& e) {
+  std::string_view m = e.what();
+  if (const auto head = m.find("] "); m.starts_with("[json.exception.") && head != std::string_view::npos) {
+    m.remove_prefix(head + 2);
+  }
+  if (const auto at = m.find("column "); at != std::string_view::npos) {
+    if (const auto colon = m.find(": ", at); colon != std::string_view::npos) m.remove_prefix(colon + 2);
+  }
+  return std::string(m);
+}
+
 // Reads JSON lines, calling `take(value, line_number, error)` for each; stops at the first problem.
 template <typename Take>
 bool read_lines(const std::string& path, std::string& error, Take take) {
@@ -45,14 +81,18 @@ bool read_lines(const std::string& path, std::string& error, Take take) {
     ++n;
     if (!text.empty() && text.back() == '\r') text.pop_back();
     if (text.find_first_not_of(" \t") == std::string::npos) continue;
-    const JsonResult r = parse_json(text);
     std::string why;
-    if (!r.value) {
-      why = "not valid JSON at column " + std::to_string(r.error.offset + 1) + ": " + r.error.message;
-    } else if (!r.value->is_object()) {
-      why = "a line must be one JSON object";
-    } else {
-      take(*r.value, n, why);
+    try {
+      const Json line = parse_line(text);
+      if (!line.is_object()) {
+        why = "a line must be one JSON object";
+      } else {
+        take(line, n, why);
+      }
+    } catch (const Json::parse_error& e) {
+      why = "not valid JSON at column " + std::to_string(e.byte) + ": " + json_message(e);
+    } catch (const Json::exception& e) {  // a number too large for a double
+      why = "not valid JSON: " + json_message(e);
     }
     if (!why.empty()) {
       error = path + ":" + std::to_string(n) + ": " + why;
@@ -66,8 +106,14 @@ bool read_lines(const std::string& path, std::string& error, Take take) {
   return true;
 }
 
-bool get_number(const JsonValue& obj, std::string_view key, double& out, std::string& why, bool required = true) {
-  const JsonValue* v = obj.find(key);
+// The member `key` of an object, or nullptr.
+const Json* member(const Json& obj, std::string_view key) {
+  const auto it = obj.find(key);
+  return it == obj.end() ? nullptr : &*it;
+}
+
+bool get_number(const Json& obj, std::string_view key, double& out, std::string& why, bool required = true) {
+  const Json* v = member(obj, key);
   if (v == nullptr) {
     if (required) why = "missing \"" + std::string(key) + "\"";
     return !required;
@@ -76,20 +122,20 @@ bool get_number(const JsonValue& obj, std::string_view key, double& out, std::st
     why = "\"" + std::string(key) + "\" must be a number";
     return false;
   }
-  out = v->number;
+  out = v->get<double>();
   return true;
 }
 
-bool get_box(const JsonValue& obj, Box& box, std::string& why, const std::string& where) {
+bool get_box(const Json& obj, Box& box, std::string& why, const std::string& where) {
   for (const auto* key : {"min", "max"}) {
-    const JsonValue* v = obj.find(key);
-    if (v == nullptr || !v->is_array() || v->items.size() != 3 ||
-        !std::all_of(v->items.begin(), v->items.end(), [](const JsonValue& e) { return e.is_number(); })) {
+    const Json* v = member(obj, key);
+    if (v == nullptr || !v->is_array() || v->size() != 3 ||
+        !std::all_of(v->begin(), v->end(), [](const Json& e) { return e.is_number(); })) {
       why = where + ": \"" + key + "\" must be an array of 3 numbers";
       return false;
     }
     auto& dst = std::string_view(key) == "min" ? box.min : box.max;
-    for (std::size_t i = 0; i < 3; ++i) dst[i] = v->items[i].number;
+    for (std::size_t i = 0; i < 3; ++i) dst[i] = (*v)[i].get<double>();
   }
   for (std::size_t i = 0; i < 3; ++i) {
     if (box.min[i] > box.max[i]) {
@@ -100,8 +146,8 @@ bool get_box(const JsonValue& obj, Box& box, std::string& why, const std::string
   return true;
 }
 
-const JsonValue* get_array(const JsonValue& obj, std::string_view key, std::string& why, bool required) {
-  const JsonValue* v = obj.find(key);
+const Json* get_array(const Json& obj, std::string_view key, std::string& why, bool required) {
+  const Json* v = member(obj, key);
   if (v == nullptr) {
     if (required) why = "missing \"" + std::string(key) + "\"";
     return nullptr;
@@ -113,26 +159,25 @@ const JsonValue* get_array(const JsonValue& obj, std::string_view key, std::stri
   return v;
 }
 
-bool get_items(const JsonValue& obj, std::string_view key, bool required, std::vector<TruthItem>& out,
-               std::string& why) {
-  const JsonValue* list = get_array(obj, key, why, required);
+bool get_items(const Json& obj, std::string_view key, bool required, std::vector<TruthItem>& out, std::string& why) {
+  const Json* list = get_array(obj, key, why, required);
   if (list == nullptr) return why.empty();
-  for (std::size_t i = 0; i < list->items.size(); ++i) {
-    const JsonValue& o = list->items[i];
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const Json& o = (*list)[i];
     const std::string where = std::string(key) + "[" + std::to_string(i) + "]";
     if (!o.is_object()) {
       why = where + " must be an object";
       return false;
     }
     TruthItem t;
-    const JsonValue* cls = o.find("class");
-    if (cls == nullptr || cls->kind != JsonValue::Kind::String) {
+    const Json* cls = member(o, "class");
+    if (cls == nullptr || !cls->is_string()) {
       why = where + ": \"class\" must be a string";
       return false;
     }
-    t.cls = cls->string;
-    const JsonValue* id = o.find("id");
-    t.id = id != nullptr && id->kind == JsonValue::Kind::String ? id->string : t.cls + "#" + std::to_string(i);
+    t.cls = cls->get<std::string>();
+    const Json* id = member(o, "id");
+    t.id = id != nullptr && id->is_string() ? id->get<std::string>() : t.cls + "#" + std::to_string(i);
     if (!get_box(o, t.box, why, where)) return false;
     double hits = 0.0;
     if (!get_number(o, "hits", hits, why)) {
@@ -145,7 +190,7 @@ bool get_items(const JsonValue& obj, std::string_view key, bool required, std::v
       why = where + ": " + why;
       return false;
     }
-    if (o.find("raised_hits") != nullptr && !(raised >= 0.0 && raised <= hits)) {
+    if (member(o, "raised_hits") != nullptr && !(raised >= 0.0 && raised <= hits)) {
       why = where + ": \"raised_hits\" must be from 0 to \"hits\"";
       return false;
     }
@@ -163,23 +208,23 @@ bool get_items(const JsonValue& obj, std::string_view key, bool required, std::v
 }  // namespace
 
 bool read_detections(const std::string& path, std::vector<DetectionFrame>& out, std::string& error) {
-  return read_lines(path, error, [&](const JsonValue& line, std::size_t n, std::string& why) {
+  return read_lines(path, error, [&](const Json& line, std::size_t n, std::string& why) {
     DetectionFrame f;
     f.line = n;
     double frame = static_cast<double>(out.size());
     if (!get_number(line, "frame", frame, why, false) || !get_number(line, "stamp", f.stamp, why)) return;
     f.frame = std::lround(frame);
-    if (const JsonValue* p = line.find("partial"); p != nullptr) {
-      if (p->kind != JsonValue::Kind::Bool) {
+    if (const Json* p = member(line, "partial"); p != nullptr) {
+      if (!p->is_boolean()) {
         why = "\"partial\" must be true or false";
         return;
       }
-      f.partial = p->boolean;
+      f.partial = p->get<bool>();
     }
-    const JsonValue* list = get_array(line, "obstacles", why, true);
+    const Json* list = get_array(line, "obstacles", why, true);
     if (list == nullptr) return;
-    for (std::size_t i = 0; i < list->items.size(); ++i) {
-      const JsonValue& o = list->items[i];
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      const Json& o = (*list)[i];
       const std::string where = "obstacles[" + std::to_string(i) + "]";
       if (!o.is_object()) {
         why = where + " must be an object";
@@ -200,7 +245,7 @@ bool read_detections(const std::string& path, std::vector<DetectionFrame>& out, 
 }
 
 bool read_truth(const std::string& path, std::vector<TruthFrame>& out, std::string& error) {
-  return read_lines(path, error, [&](const JsonValue& line, std::size_t n, std::string& why) {
+  return read_lines(path, error, [&](const Json& line, std::size_t n, std::string& why) {
     TruthFrame f;
     f.line = n;
     double frame = static_cast<double>(out.size());
