@@ -38,31 +38,31 @@ TEST(InspectCandump, RealJ1939TruckLog) {
   EXPECT_EQ(summary_number(run.output, "extended"), 300);
 
   // The first line: (1635188455.020850) can0 18F00E00#821639C4FFFFFFFF
-  EXPECT_EQ(r[0]["type"].text, "can");
-  EXPECT_EQ(r[0]["time"].number, 1635188455.020850);
-  EXPECT_EQ(r[0]["iface"].text, "can0");
-  EXPECT_EQ(r[0]["id"].text, "18F00E00");
-  EXPECT_TRUE(r[0]["extended"].boolean);
-  EXPECT_EQ(r[0]["dlc"].integer(), 8);
-  EXPECT_EQ(r[0]["data"].text, "821639C4FFFFFFFF");
+  EXPECT_EQ(r[0].at("type").get<std::string>(), "can");
+  EXPECT_EQ(r[0].at("time").get<double>(), 1635188455.020850);
+  EXPECT_EQ(r[0].at("iface").get<std::string>(), "can0");
+  EXPECT_EQ(r[0].at("id").get<std::string>(), "18F00E00");
+  EXPECT_TRUE(r[0].at("extended").get<bool>());
+  EXPECT_EQ(r[0].at("dlc").get<long long>(), 8);
+  EXPECT_EQ(r[0].at("data").get<std::string>(), "821639C4FFFFFFFF");
 
   std::size_t eec1 = 0;
   std::size_t ccvs1 = 0;
   for (const auto& f : r) {
-    if (f["id"].text == "0CF00400") {  // EEC1, 100 Hz while the engine idles
+    if (f.at("id").get<std::string>() == "0CF00400") {  // EEC1, 100 Hz while the engine idles
       ++eec1;
-      EXPECT_EQ(f["pgn"].integer(), 61444);  // 0xF004
-      EXPECT_EQ(f["sa"].integer(), 0x00);
-      EXPECT_EQ(f["priority"].integer(), 3);
-      EXPECT_FALSE(f.has("da"));              // PDU2: PF 0xF0 >= 240
-    } else if (f["id"].text == "0CFEF100") {  // CCVS1 at priority 3
+      EXPECT_EQ(f.at("pgn").get<long long>(), 61444);  // 0xF004
+      EXPECT_EQ(f.at("sa").get<long long>(), 0x00);
+      EXPECT_EQ(f.at("priority").get<long long>(), 3);
+      EXPECT_FALSE(f.contains("da"));              // PDU2: PF 0xF0 >= 240
+    } else if (f.at("id").get<std::string>() == "0CFEF100") {  // CCVS1 at priority 3
       ++ccvs1;
-      EXPECT_EQ(f["pgn"].integer(), 65265);  // 0xFEF1
-      EXPECT_EQ(f["sa"].integer(), 0x00);
-      EXPECT_EQ(f["priority"].integer(), 3);
-    } else if (f["id"].text == "1CECFF00") {  // TP.CM, PDU1 to the global address
-      EXPECT_EQ(f["pgn"].integer(), 0xEC00);
-      EXPECT_EQ(f["da"].integer(), 0xFF);
+      EXPECT_EQ(f.at("pgn").get<long long>(), 65265);  // 0xFEF1
+      EXPECT_EQ(f.at("sa").get<long long>(), 0x00);
+      EXPECT_EQ(f.at("priority").get<long long>(), 3);
+    } else if (f.at("id").get<std::string>() == "1CECFF00") {  // TP.CM, PDU1 to the global address
+      EXPECT_EQ(f.at("pgn").get<long long>(), 0xEC00);
+      EXPECT_EQ(f.at("da").get<long long>(), 0xFF);
     }
   }
   EXPECT_EQ(eec1, 84U);
@@ -87,41 +87,41 @@ TEST(InspectCandump, EveryFrameFormOfTheLogFormat) {
   const auto r = testing::json_lines(run.output);
   ASSERT_EQ(r.size(), 10U) << run.output;
 
-  EXPECT_EQ(r[0]["pgn"].integer(), 65265);
-  EXPECT_EQ(r[0]["priority"].integer(), 6);
-  EXPECT_EQ(r[0]["sa"].integer(), 0);
-  EXPECT_EQ(r[1]["pgn"].integer(), 0xEF00);
-  EXPECT_EQ(r[1]["da"].integer(), 0x26);
-  EXPECT_EQ(r[1]["sa"].integer(), 0x80);
-  EXPECT_EQ(r[1]["dlc"].integer(), 2);
-  EXPECT_EQ(r[2]["iface"].text, "vcan1");
-  EXPECT_EQ(r[2]["pgn"].integer(), 33280);
-  EXPECT_EQ(r[2]["da"].integer(), 0x0E);
-  EXPECT_EQ(r[2]["sa"].integer(), 0x0F);
-  EXPECT_EQ(r[2]["dlc"].integer(), 0);
-  EXPECT_EQ(r[2]["data"].text, "");
+  EXPECT_EQ(r[0].at("pgn").get<long long>(), 65265);
+  EXPECT_EQ(r[0].at("priority").get<long long>(), 6);
+  EXPECT_EQ(r[0].at("sa").get<long long>(), 0);
+  EXPECT_EQ(r[1].at("pgn").get<long long>(), 0xEF00);
+  EXPECT_EQ(r[1].at("da").get<long long>(), 0x26);
+  EXPECT_EQ(r[1].at("sa").get<long long>(), 0x80);
+  EXPECT_EQ(r[1].at("dlc").get<long long>(), 2);
+  EXPECT_EQ(r[2].at("iface").get<std::string>(), "vcan1");
+  EXPECT_EQ(r[2].at("pgn").get<long long>(), 33280);
+  EXPECT_EQ(r[2].at("da").get<long long>(), 0x0E);
+  EXPECT_EQ(r[2].at("sa").get<long long>(), 0x0F);
+  EXPECT_EQ(r[2].at("dlc").get<long long>(), 0);
+  EXPECT_EQ(r[2].at("data").get<std::string>(), "");
 
-  EXPECT_EQ(r[3]["id"].text, "123");
-  EXPECT_FALSE(r[3]["extended"].boolean);
-  EXPECT_FALSE(r[3].has("pgn"));
-  EXPECT_EQ(r[3]["data"].text, "DEADBEEF");
-  EXPECT_TRUE(r[4]["rtr"].boolean);
-  EXPECT_EQ(r[4]["dlc"].integer(), 0);
-  EXPECT_EQ(r[5]["id"].text, "7FF");
-  EXPECT_EQ(r[5]["dlc"].integer(), 5);
-  EXPECT_EQ(r[5]["data"].text, "");
-  EXPECT_EQ(r[5]["dir"].text, "T");
-  EXPECT_EQ(r[6]["data"].text, "1122334455667788");
-  EXPECT_EQ(r[6]["len8_dlc"].integer(), 14);
-  EXPECT_TRUE(r[7]["fd"].boolean);
-  EXPECT_EQ(r[7]["fd_flags"].integer(), 1);
-  EXPECT_EQ(r[7]["data"].text, "112233");
-  EXPECT_EQ(r[8]["type"].text, "can_error");
-  EXPECT_EQ(r[8]["id"].text, "20000040");
-  EXPECT_EQ(r[8]["error_class"].integer(), 0x40);
-  EXPECT_EQ(r[9]["id"].text, "1FFFFFFF");
-  EXPECT_EQ(r[9]["dir"].text, "R");
-  EXPECT_EQ(r[9]["priority"].integer(), 7);
+  EXPECT_EQ(r[3].at("id").get<std::string>(), "123");
+  EXPECT_FALSE(r[3].at("extended").get<bool>());
+  EXPECT_FALSE(r[3].contains("pgn"));
+  EXPECT_EQ(r[3].at("data").get<std::string>(), "DEADBEEF");
+  EXPECT_TRUE(r[4].at("rtr").get<bool>());
+  EXPECT_EQ(r[4].at("dlc").get<long long>(), 0);
+  EXPECT_EQ(r[5].at("id").get<std::string>(), "7FF");
+  EXPECT_EQ(r[5].at("dlc").get<long long>(), 5);
+  EXPECT_EQ(r[5].at("data").get<std::string>(), "");
+  EXPECT_EQ(r[5].at("dir").get<std::string>(), "T");
+  EXPECT_EQ(r[6].at("data").get<std::string>(), "1122334455667788");
+  EXPECT_EQ(r[6].at("len8_dlc").get<long long>(), 14);
+  EXPECT_TRUE(r[7].at("fd").get<bool>());
+  EXPECT_EQ(r[7].at("fd_flags").get<long long>(), 1);
+  EXPECT_EQ(r[7].at("data").get<std::string>(), "112233");
+  EXPECT_EQ(r[8].at("type").get<std::string>(), "can_error");
+  EXPECT_EQ(r[8].at("id").get<std::string>(), "20000040");
+  EXPECT_EQ(r[8].at("error_class").get<long long>(), 0x40);
+  EXPECT_EQ(r[9].at("id").get<std::string>(), "1FFFFFFF");
+  EXPECT_EQ(r[9].at("dir").get<std::string>(), "R");
+  EXPECT_EQ(r[9].at("priority").get<long long>(), 7);
   EXPECT_EQ(summary_number(run.output, "can"), 9);
   EXPECT_EQ(summary_number(run.output, "can_error"), 1);
   EXPECT_EQ(summary_number(run.output, "standard"), 5);
@@ -142,19 +142,19 @@ TEST(InspectCandump, DefaultSpacedOutput) {
   EXPECT_NE(run.output.find("candump (guessed)"), std::string::npos) << run.output;
   const auto r = testing::json_lines(run.output);
   ASSERT_EQ(r.size(), 4U) << run.output;
-  EXPECT_TRUE(r[0]["time"].is_null());
-  EXPECT_EQ(r[0]["pgn"].integer(), 65265);
-  EXPECT_EQ(r[0]["data"].text, "00FF0000FFFFFFFF");
-  EXPECT_EQ(r[1]["time"].number, 1621880457.123456);
-  EXPECT_EQ(r[1]["iface"].text, "can1");
-  EXPECT_EQ(r[1]["data"].text, "DEADBEEF");
-  EXPECT_TRUE(r[2]["rtr"].boolean);
-  EXPECT_EQ(r[2]["dlc"].integer(), 3);
-  EXPECT_TRUE(r[3]["fd"].boolean);
-  EXPECT_EQ(r[3]["fd_flags"].integer(), 1);
-  EXPECT_EQ(r[3]["dlc"].integer(), 12);
-  EXPECT_EQ(r[3]["pgn"].integer(), 61444);
-  EXPECT_EQ(r[3]["dir"].text, "R");
+  EXPECT_TRUE(r[0].at("time").is_null());
+  EXPECT_EQ(r[0].at("pgn").get<long long>(), 65265);
+  EXPECT_EQ(r[0].at("data").get<std::string>(), "00FF0000FFFFFFFF");
+  EXPECT_EQ(r[1].at("time").get<double>(), 1621880457.123456);
+  EXPECT_EQ(r[1].at("iface").get<std::string>(), "can1");
+  EXPECT_EQ(r[1].at("data").get<std::string>(), "DEADBEEF");
+  EXPECT_TRUE(r[2].at("rtr").get<bool>());
+  EXPECT_EQ(r[2].at("dlc").get<long long>(), 3);
+  EXPECT_TRUE(r[3].at("fd").get<bool>());
+  EXPECT_EQ(r[3].at("fd_flags").get<long long>(), 1);
+  EXPECT_EQ(r[3].at("dlc").get<long long>(), 12);
+  EXPECT_EQ(r[3].at("pgn").get<long long>(), 61444);
+  EXPECT_EQ(r[3].at("dir").get<std::string>(), "R");
   EXPECT_EQ(summary_number(run.output, "bad_data"), 1);
   EXPECT_EQ(summary_number(run.output, "blank_lines"), 1);
 }

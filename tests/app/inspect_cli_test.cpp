@@ -101,36 +101,36 @@ TEST(InspectCli, NmeaRecordsCarryTheDocumentedKeys) {
   ASSERT_EQ(r.size(), 6U) << run.output;
 
   const Json& gga = r[0];
-  EXPECT_EQ(gga["type"].text, "GNGGA");
-  EXPECT_EQ(gga["time_utc"].text, "08:30:15.000");
-  EXPECT_NEAR(gga["lat_deg"].number, 39.90205750, 1e-8);
-  EXPECT_NEAR(gga["lon_deg"].number, 116.39094633, 1e-8);
-  EXPECT_EQ(gga["alt_m"].number, 52.3);
-  EXPECT_EQ(gga["quality"].integer(), 4);
-  EXPECT_EQ(gga["sats"].integer(), 18);
-  EXPECT_EQ(gga["hdop"].number, 0.7);
-  EXPECT_NEAR(gga["alt_hae_m"].number, 43.9, 1e-9);  // protocols.md §4.4
+  EXPECT_EQ(gga.at("type").get<std::string>(), "GNGGA");
+  EXPECT_EQ(gga.at("time_utc").get<std::string>(), "08:30:15.000");
+  EXPECT_NEAR(gga.at("lat_deg").get<double>(), 39.90205750, 1e-8);
+  EXPECT_NEAR(gga.at("lon_deg").get<double>(), 116.39094633, 1e-8);
+  EXPECT_EQ(gga.at("alt_m").get<double>(), 52.3);
+  EXPECT_EQ(gga.at("quality").get<long long>(), 4);
+  EXPECT_EQ(gga.at("sats").get<long long>(), 18);
+  EXPECT_EQ(gga.at("hdop").get<double>(), 0.7);
+  EXPECT_NEAR(gga.at("alt_hae_m").get<double>(), 43.9, 1e-9);  // protocols.md §4.4
 
-  EXPECT_EQ(r[1]["type"].text, "GNRMC");
-  EXPECT_EQ(r[1]["status"].text, "A");
-  EXPECT_EQ(r[1]["date"].text, "2024-03-21");
-  EXPECT_NEAR(r[1]["speed_mps"].number, 0.52 * 1852.0 / 3600.0, 1e-12);
-  EXPECT_EQ(r[1]["course_deg"].number, 87.3);
-  EXPECT_EQ(r[1]["mode"].text, "R");
-  EXPECT_EQ(r[2]["type"].text, "GNVTG");
-  EXPECT_EQ(r[2]["course_true_deg"].number, 87.3);
-  EXPECT_TRUE(r[2]["course_mag_deg"].is_null());
-  EXPECT_EQ(r[3]["type"].text, "GNHDT");
-  EXPECT_EQ(r[3]["heading_deg"].number, 271.45);
-  EXPECT_EQ(r[4]["type"].text, "GNTHS");
-  EXPECT_EQ(r[4]["mode"].text, "A");
+  EXPECT_EQ(r[1].at("type").get<std::string>(), "GNRMC");
+  EXPECT_EQ(r[1].at("status").get<std::string>(), "A");
+  EXPECT_EQ(r[1].at("date").get<std::string>(), "2024-03-21");
+  EXPECT_NEAR(r[1].at("speed_mps").get<double>(), 0.52 * 1852.0 / 3600.0, 1e-12);
+  EXPECT_EQ(r[1].at("course_deg").get<double>(), 87.3);
+  EXPECT_EQ(r[1].at("mode").get<std::string>(), "R");
+  EXPECT_EQ(r[2].at("type").get<std::string>(), "GNVTG");
+  EXPECT_EQ(r[2].at("course_true_deg").get<double>(), 87.3);
+  EXPECT_TRUE(r[2].at("course_mag_deg").is_null());
+  EXPECT_EQ(r[3].at("type").get<std::string>(), "GNHDT");
+  EXPECT_EQ(r[3].at("heading_deg").get<double>(), 271.45);
+  EXPECT_EQ(r[4].at("type").get<std::string>(), "GNTHS");
+  EXPECT_EQ(r[4].at("mode").get<std::string>(), "A");
 
   // Empty fields are null, not 0; the fix quality "0" is there.
   const Json& empty = r[5];
   for (const char* k : {"time_utc", "lat_deg", "lon_deg", "alt_m", "sats", "hdop"}) {
-    EXPECT_TRUE(empty.has(k) && empty[k].is_null()) << k;
+    EXPECT_TRUE(empty.contains(k) && empty.at(k).is_null()) << k;
   }
-  EXPECT_EQ(empty["quality"].integer(), 0);
+  EXPECT_EQ(empty.at("quality").get<long long>(), 0);
 
   EXPECT_EQ(summary_number(run.output, "records"), 6);
   EXPECT_EQ(summary_number(run.output, "GNGGA"), 1);
@@ -151,14 +151,14 @@ TEST(InspectCli, XsensRecordsCarryTheDocumentedKeys) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto r = testing::json_lines(run.output);
   ASSERT_EQ(r.size(), 2U) << run.output;
-  EXPECT_EQ(r[0]["type"].text, "MTData2");
-  EXPECT_EQ(r[0]["packet_counter"].integer(), 42581);
-  EXPECT_EQ(r[0]["sample_time_fine"].integer(), 5719854);
-  EXPECT_EQ(r[0]["euler_deg"].numbers(), (std::vector<double>{1.5, -2.25, 90.0}));
-  EXPECT_EQ(r[0]["euler_frame"].text, "ENU");
-  EXPECT_EQ(r[0]["status_word"].integer(), 0x00400003);
-  EXPECT_FALSE(r[0].has("quat"));
-  EXPECT_EQ(r[1]["type"].text, "GoToConfigAck");
+  EXPECT_EQ(r[0].at("type").get<std::string>(), "MTData2");
+  EXPECT_EQ(r[0].at("packet_counter").get<long long>(), 42581);
+  EXPECT_EQ(r[0].at("sample_time_fine").get<long long>(), 5719854);
+  EXPECT_EQ(r[0].at("euler_deg").get<std::vector<double>>(), (std::vector<double>{1.5, -2.25, 90.0}));
+  EXPECT_EQ(r[0].at("euler_frame").get<std::string>(), "ENU");
+  EXPECT_EQ(r[0].at("status_word").get<long long>(), 0x00400003);
+  EXPECT_FALSE(r[0].contains("quat"));
+  EXPECT_EQ(r[1].at("type").get<std::string>(), "GoToConfigAck");
   EXPECT_EQ(summary_number(run.output, "garbage_bytes"), 3);
   EXPECT_EQ(summary_number(run.output, "GoToConfigAck"), 1);
 

@@ -59,7 +59,7 @@ double seconds_of_day(const std::string& hh_mm_ss) {
 
 int gpsd_status(const Json& quality) {
   if (quality.is_null()) return 0;
-  switch (quality.integer()) {
+  switch (quality.get<long long>()) {
     case 1: return 1;
     case 2: return 2;
     case 3: return 9;
@@ -106,7 +106,7 @@ void compare_with_gpsd(const std::string& log, const std::vector<Json>& records,
   std::vector<const Json*> gga;
   std::vector<const Json*> rmc;
   for (const auto& r : records) {
-    const std::string& type = r["type"].text;
+    const std::string type = r.at("type").get<std::string>();
     if (type.size() == 5 && type.substr(2) == "GGA") gga.push_back(&r);
     if (type.size() == 5 && type.substr(2) == "RMC") rmc.push_back(&r);
   }
@@ -118,35 +118,35 @@ void compare_with_gpsd(const std::string& log, const std::vector<Json>& records,
     ++result.compared;
 
     // Time (and for RMC the date) against the TPV time.
-    ASSERT_FALSE(r["time_utc"].is_null()) << where;
-    EXPECT_NEAR(seconds_of_day(r["time_utc"].text), seconds_of_day(e.time.substr(11, 12)), 5e-4) << where;
+    ASSERT_FALSE(r.at("time_utc").is_null()) << where;
+    EXPECT_NEAR(seconds_of_day(r.at("time_utc").get<std::string>()), seconds_of_day(e.time.substr(11, 12)), 5e-4) << where;
     if (e.kind == "RMC") {
-      EXPECT_EQ(r["date"].text, e.time.substr(0, 10)) << where;
+      EXPECT_EQ(r.at("date").get<std::string>(), e.time.substr(0, 10)) << where;
     }
 
     if (e.lat != "-") {
-      ASSERT_TRUE(r["lat_deg"].opt() && r["lon_deg"].opt()) << where;
-      const double d = std::max(std::abs(r["lat_deg"].number - std::stod(e.lat)),
-                                std::abs(r["lon_deg"].number - std::stod(e.lon)));
+      ASSERT_TRUE(r.at("lat_deg").is_number() && r.at("lon_deg").is_number()) << where;
+      const double d = std::max(std::abs(r.at("lat_deg").get<double>() - std::stod(e.lat)),
+                                std::abs(r.at("lon_deg").get<double>() - std::stod(e.lon)));
       EXPECT_LE(d, kLatLonTolerance) << where;
       result.max_pos_diff = std::max(result.max_pos_diff, d);
     }
     if (e.kind != "GGA") continue;
     ++result.gga;
 
-    const int status = gpsd_status(r["quality"]);
+    const int status = gpsd_status(r.at("quality"));
     EXPECT_EQ(status >= 2 ? std::to_string(status) : std::string("-"), e.status) << where << " quality "
-                                                                                    << r["quality"].text;
+                                                                                    << testing::text(r.at("quality"));
     if (e.mode >= 2) {
-      EXPECT_TRUE(r["lat_deg"].opt().has_value()) << where << ": gpsd has a fix, the GGA no position";
-      EXPECT_GE(r["quality"].opt().value_or(0.0), 1.0) << where << ": gpsd has a fix, the GGA quality is 0";
+      EXPECT_TRUE(r.at("lat_deg").is_number()) << where << ": gpsd has a fix, the GGA no position";
+      EXPECT_GE(r.at("quality").is_number() ? r.at("quality").get<double>() : 0.0, 1.0) << where << ": gpsd has a fix, the GGA quality is 0";
     }
     if (e.alt_msl != "-") {
-      ASSERT_TRUE(r["alt_m"].opt()) << where;
-      EXPECT_NEAR(r["alt_m"].number, std::stod(e.alt_msl), kAltTolerance) << where;
+      ASSERT_TRUE(r.at("alt_m").is_number()) << where;
+      EXPECT_NEAR(r.at("alt_m").get<double>(), std::stod(e.alt_msl), kAltTolerance) << where;
     }
-    if (e.alt_hae != "-" && r["alt_hae_m"].opt()) {
-      EXPECT_NEAR(r["alt_hae_m"].number, std::stod(e.alt_hae), kAltTolerance) << where;
+    if (e.alt_hae != "-" && r.at("alt_hae_m").is_number()) {
+      EXPECT_NEAR(r.at("alt_hae_m").get<double>(), std::stod(e.alt_hae), kAltTolerance) << where;
     }
   }
 }

@@ -73,31 +73,31 @@ TEST(InspectRobosense, MsopAndDifopRecordsAndRejectionsByReason) {
   ASSERT_EQ(r.size(), 7U) << run.output;
 
   const Json& difop = r[0];
-  EXPECT_EQ(difop["type"].text, "robosense_difop");
-  EXPECT_EQ(difop["port"].integer(), 7788);
-  EXPECT_EQ(difop["rpm"].integer(), 600);
-  EXPECT_EQ(difop["firmware_top"].text, "09230906A1");
-  EXPECT_EQ(difop["serial"].text, "101112131415");
-  EXPECT_EQ(difop["return_mode"].text, "strongest");
-  EXPECT_EQ(difop["return_mode_byte"].integer(), 1);
-  EXPECT_EQ(difop["distance_unit"].text, "0.5cm");
-  EXPECT_EQ(difop["fov_end_deg"].number, 360.0);
-  EXPECT_EQ(difop["timestamp_utc"].text, "2024-03-21T08:30:15.123456Z");
-  EXPECT_TRUE(difop["angle_table"].boolean);
-  EXPECT_EQ(difop["time"].text, "1711009815.203");
+  EXPECT_EQ(difop.at("type").get<std::string>(), "robosense_difop");
+  EXPECT_EQ(difop.at("port").get<long long>(), 7788);
+  EXPECT_EQ(difop.at("rpm").get<long long>(), 600);
+  EXPECT_EQ(difop.at("firmware_top").get<std::string>(), "09230906A1");
+  EXPECT_EQ(difop.at("serial").get<std::string>(), "101112131415");
+  EXPECT_EQ(difop.at("return_mode").get<std::string>(), "strongest");
+  EXPECT_EQ(difop.at("return_mode_byte").get<long long>(), 1);
+  EXPECT_EQ(difop.at("distance_unit").get<std::string>(), "0.5cm");
+  EXPECT_EQ(difop.at("fov_end_deg").get<double>(), 360.0);
+  EXPECT_EQ(difop.at("timestamp_utc").get<std::string>(), "2024-03-21T08:30:15.123456Z");
+  EXPECT_TRUE(difop.at("angle_table").get<bool>());
+  EXPECT_EQ(testing::text(difop.at("time")), "1711009815.203");
 
   for (std::size_t i = 1; i < r.size(); ++i) {
     const Json& m = r[i];
     const int k = static_cast<int>(i) + 1;
-    EXPECT_EQ(m["type"].text, "robosense_msop");
-    EXPECT_EQ(m["port"].integer(), 6699);
-    EXPECT_EQ(m["points"].integer(), 384) << i;  // 12 blocks x 32 channels, all in range
-    EXPECT_EQ(m["first_azimuth_deg"].number, (k * 240) / 100.0);
-    EXPECT_EQ(m["last_azimuth_deg"].number, (k * 240 + 220) / 100.0);
-    EXPECT_FALSE(m["dual_layout"].boolean);
-    EXPECT_EQ(m["temperature_c"].number, 0.0);
+    EXPECT_EQ(m.at("type").get<std::string>(), "robosense_msop");
+    EXPECT_EQ(m.at("port").get<long long>(), 6699);
+    EXPECT_EQ(m.at("points").get<long long>(), 384) << i;  // 12 blocks x 32 channels, all in range
+    EXPECT_EQ(m.at("first_azimuth_deg").get<double>(), (k * 240) / 100.0);
+    EXPECT_EQ(m.at("last_azimuth_deg").get<double>(), (k * 240 + 220) / 100.0);
+    EXPECT_FALSE(m.at("dual_layout").get<bool>());
+    EXPECT_EQ(m.at("temperature_c").get<double>(), 0.0);
   }
-  EXPECT_EQ(r[1]["timestamp_utc"].text, "2024-03-21T08:30:15.125456Z");
+  EXPECT_EQ(r[1].at("timestamp_utc").get<std::string>(), "2024-03-21T08:30:15.125456Z");
 
   EXPECT_EQ(summary_number(run.output, "robosense_msop"), 6);
   EXPECT_EQ(summary_number(run.output, "robosense_difop"), 1);
@@ -148,8 +148,8 @@ TEST(InspectRobosense, PortOptionsAndTheGuessFromSizes) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto r = testing::json_lines(run.output);
   ASSERT_EQ(r.size(), 4U) << run.output;
-  EXPECT_EQ(r[0]["type"].text, "robosense_difop");
-  EXPECT_EQ(r[3]["points"].integer(), 384);
+  EXPECT_EQ(r[0].at("type").get<std::string>(), "robosense_difop");
+  EXPECT_EQ(r[3].at("points").get<long long>(), 384);
 }
 
 }  // namespace

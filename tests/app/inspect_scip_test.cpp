@@ -120,44 +120,44 @@ void expect_session(const std::string& output, bool with_times) {
   EXPECT_EQ(bad, 0U);
   ASSERT_EQ(r.size(), 9U) << output;
   std::vector<std::string> types;
-  for (const auto& rec : r) types.push_back(rec["type"].text + ":" + rec["command"].text);
+  for (const auto& rec : r) types.push_back(rec.at("type").get<std::string>() + ":" + rec.at("command").get<std::string>());
   EXPECT_EQ(types, (std::vector<std::string>{"scip_status:SCIP2.0", "scip_info:VV", "scip_info:PP", "scip_info:II",
                                              "scip_status:BM", "scip_scan:MD", "scip_scan:MD", "scip_scan:MD",
                                              "scip_scan:GD"}));
-  EXPECT_EQ(r[0]["status"].text, "0E");
-  EXPECT_EQ(r[0]["text"].text, "command not defined");
-  EXPECT_EQ(r[1]["SERI"].text, "H1234567");
-  EXPECT_EQ(r[1]["PROT"].text, "SCIP 2.0");
-  EXPECT_EQ(r[2]["MODL"].text, "UTM-30LX-EW");
-  EXPECT_EQ(r[2]["AFRT"].text, "540");
-  EXPECT_EQ(r[3]["STAT"].text, "Stable 000 no error.");
-  EXPECT_EQ(r[4]["status"].text, "02");
-  EXPECT_EQ(r[4]["category"].text, "parameter_error");
-  EXPECT_EQ(r[4]["text"].text, "laser already on");
+  EXPECT_EQ(r[0].at("status").get<std::string>(), "0E");
+  EXPECT_EQ(r[0].at("text").get<std::string>(), "command not defined");
+  EXPECT_EQ(r[1].at("SERI").get<std::string>(), "H1234567");
+  EXPECT_EQ(r[1].at("PROT").get<std::string>(), "SCIP 2.0");
+  EXPECT_EQ(r[2].at("MODL").get<std::string>(), "UTM-30LX-EW");
+  EXPECT_EQ(r[2].at("AFRT").get<std::string>(), "540");
+  EXPECT_EQ(r[3].at("STAT").get<std::string>(), "Stable 000 no error.");
+  EXPECT_EQ(r[4].at("status").get<std::string>(), "02");
+  EXPECT_EQ(r[4].at("category").get<std::string>(), "parameter_error");
+  EXPECT_EQ(r[4].at("text").get<std::string>(), "laser already on");
 
   const Json& scan = r[5];
-  EXPECT_EQ(scan["timestamp_ms"].integer(), 1000);
-  EXPECT_EQ(scan["first_step"].integer(), 0);
-  EXPECT_EQ(scan["last_step"].integer(), 1080);
-  EXPECT_EQ(scan["cluster"].integer(), 1);
-  EXPECT_EQ(scan["remaining_scans"].integer(), 0);
-  EXPECT_EQ(scan["values"].integer(), 1081);
+  EXPECT_EQ(scan.at("timestamp_ms").get<long long>(), 1000);
+  EXPECT_EQ(scan.at("first_step").get<long long>(), 0);
+  EXPECT_EQ(scan.at("last_step").get<long long>(), 1080);
+  EXPECT_EQ(scan.at("cluster").get<long long>(), 1);
+  EXPECT_EQ(scan.at("remaining_scans").get<long long>(), 0);
+  EXPECT_EQ(scan.at("values").get<long long>(), 1081);
   const Valid v = valid(st::range_pattern(1081, 1));
-  EXPECT_EQ(scan["valid"].integer(), v.n);
-  EXPECT_EQ(scan["min_range_mm"].integer(), v.lo);
-  EXPECT_EQ(scan["max_range_mm"].integer(), v.hi);
-  EXPECT_FALSE(scan["intensities"].boolean);
-  EXPECT_EQ(r[6]["timestamp_ms"].integer(), 1025);
-  EXPECT_EQ(r[7]["timestamp_ms"].integer(), 1075);
-  EXPECT_EQ(r[8]["timestamp_ms"].integer(), 2000);
-  EXPECT_EQ(r[8]["valid"].integer(), valid(st::range_pattern(1081, 4)).n);
+  EXPECT_EQ(scan.at("valid").get<long long>(), v.n);
+  EXPECT_EQ(scan.at("min_range_mm").get<long long>(), v.lo);
+  EXPECT_EQ(scan.at("max_range_mm").get<long long>(), v.hi);
+  EXPECT_FALSE(scan.at("intensities").get<bool>());
+  EXPECT_EQ(r[6].at("timestamp_ms").get<long long>(), 1025);
+  EXPECT_EQ(r[7].at("timestamp_ms").get<long long>(), 1075);
+  EXPECT_EQ(r[8].at("timestamp_ms").get<long long>(), 2000);
+  EXPECT_EQ(r[8].at("valid").get<long long>(), valid(st::range_pattern(1081, 4)).n);
   if (with_times) {
-    EXPECT_EQ(r[0]["time"].number, seconds(time_of(1)));
-    EXPECT_EQ(r[3]["time"].number, seconds(time_of(4)));
-    EXPECT_EQ(r[6]["time"].number, seconds(time_of(13)));  // completed by the second read
-    EXPECT_EQ(r[8]["time"].number, seconds(time_of(21)));
+    EXPECT_EQ(r[0].at("time").get<double>(), seconds(time_of(1)));
+    EXPECT_EQ(r[3].at("time").get<double>(), seconds(time_of(4)));
+    EXPECT_EQ(r[6].at("time").get<double>(), seconds(time_of(13)));  // completed by the second read
+    EXPECT_EQ(r[8].at("time").get<double>(), seconds(time_of(21)));
   } else {
-    for (const auto& rec : r) EXPECT_TRUE(rec.has("time") && rec["time"].is_null());
+    for (const auto& rec : r) EXPECT_TRUE(rec.contains("time") && rec.at("time").is_null());
   }
 
   EXPECT_EQ(summary_number(output, "scip_scan"), 4);

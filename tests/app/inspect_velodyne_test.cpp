@@ -55,7 +55,7 @@ std::string arg(const std::string& path) { return "'" + path + "'"; }
 
 long long total_points(const std::vector<Json>& records) {
   return std::accumulate(records.begin(), records.end(), 0LL,
-                         [](long long s, const Json& r) { return s + (r.has("points") ? r["points"].integer() : 0); });
+                         [](long long s, const Json& r) { return s + (r.contains("points") ? r.at("points").get<long long>() : 0); });
 }
 
 TEST(InspectVelodyne, Hdl32eMontereyDataAndPositionRecords) {
@@ -72,32 +72,32 @@ TEST(InspectVelodyne, Hdl32eMontereyDataAndPositionRecords) {
   EXPECT_NE(run.output.find("  model              HDL-32E (spacing 553 us"), std::string::npos) << run.output;
 
   const Json& d = r[0];
-  EXPECT_EQ(d["type"].text, "velodyne_data");
-  EXPECT_EQ(d["time"].text, "1355263594.123168");
-  EXPECT_EQ(d["port"].integer(), 2368);
-  EXPECT_EQ(d["timestamp_us"].integer(), 393203883);
-  EXPECT_EQ(d["return_mode"].text, "strongest");
-  EXPECT_EQ(d["product_byte"].integer(), 0x21);
-  EXPECT_EQ(d["first_azimuth_deg"].number, 150.54);
-  EXPECT_EQ(d["last_azimuth_deg"].number, 152.7);
-  EXPECT_EQ(d["points"].integer(), 339);
+  EXPECT_EQ(d.at("type").get<std::string>(), "velodyne_data");
+  EXPECT_EQ(testing::text(d.at("time")), "1355263594.123168");
+  EXPECT_EQ(d.at("port").get<long long>(), 2368);
+  EXPECT_EQ(d.at("timestamp_us").get<long long>(), 393203883);
+  EXPECT_EQ(d.at("return_mode").get<std::string>(), "strongest");
+  EXPECT_EQ(d.at("product_byte").get<long long>(), 0x21);
+  EXPECT_EQ(d.at("first_azimuth_deg").get<double>(), 150.54);
+  EXPECT_EQ(d.at("last_azimuth_deg").get<double>(), 152.7);
+  EXPECT_EQ(d.at("points").get<long long>(), 339);
 
   std::size_t data = 0;
   std::size_t positions = 0;
   for (const auto& rec : r) {
-    if (rec["type"].text == "velodyne_data") {
+    if (rec.at("type").get<std::string>() == "velodyne_data") {
       ++data;
-      EXPECT_GT(rec["points"].integer(), 0);
-      EXPECT_LE(rec["points"].integer(), 384);
+      EXPECT_GT(rec.at("points").get<long long>(), 0);
+      EXPECT_LE(rec.at("points").get<long long>(), 384);
     } else {
-      ASSERT_EQ(rec["type"].text, "velodyne_position");
+      ASSERT_EQ(rec.at("type").get<std::string>(), "velodyne_position");
       ++positions;
-      EXPECT_EQ(rec["port"].integer(), 8308);
-      EXPECT_EQ(rec["pps"].text, "absent");  // the HDL-32E leaves byte 202 at 0
-      EXPECT_EQ(rec["nmea"].text.rfind("$GPRMC,", 0), 0U) << rec["nmea"].text;
-      EXPECT_NEAR(rec["lat_deg"].number, 37.13, 0.01);  // Monterey highway, California
-      EXPECT_NEAR(rec["lon_deg"].number, -121.65, 0.01);
-      EXPECT_TRUE(rec.has("timestamp_us") && rec.has("time"));
+      EXPECT_EQ(rec.at("port").get<long long>(), 8308);
+      EXPECT_EQ(rec.at("pps").get<std::string>(), "absent");  // the HDL-32E leaves byte 202 at 0
+      EXPECT_EQ(rec.at("nmea").get<std::string>().rfind("$GPRMC,", 0), 0U) << rec.at("nmea").get<std::string>();
+      EXPECT_NEAR(rec.at("lat_deg").get<double>(), 37.13, 0.01);  // Monterey highway, California
+      EXPECT_NEAR(rec.at("lon_deg").get<double>(), -121.65, 0.01);
+      EXPECT_TRUE(rec.contains("timestamp_us") && rec.contains("time"));
     }
   }
   EXPECT_EQ(data, 540U);
@@ -115,14 +115,14 @@ TEST(InspectVelodyne, Vlp16DetectedDespiteTheHdl32eProductByte) {
   ASSERT_EQ(r.size(), 300U);
   EXPECT_NE(run.output.find("  model              VLP-16 (spacing 1327 us"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("product byte 0x21 (HDL-32E) is what early VLP-16 firmware reports"), std::string::npos);
-  EXPECT_EQ(r[0]["product_byte"].integer(), 0x21);
+  EXPECT_EQ(r[0].at("product_byte").get<long long>(), 0x21);
   std::size_t positions = 0;
   for (const auto& rec : r) {
-    if (rec["type"].text == "velodyne_position") {
+    if (rec.at("type").get<std::string>() == "velodyne_position") {
       ++positions;
-      EXPECT_EQ(rec["port"].integer(), 8308);
+      EXPECT_EQ(rec.at("port").get<long long>(), 8308);
     } else {
-      EXPECT_LE(rec["points"].integer(), 384);  // 12 blocks x 32 slots
+      EXPECT_LE(rec.at("points").get<long long>(), 384);  // 12 blocks x 32 slots
     }
   }
   EXPECT_EQ(total_points(r), summary_number(run.output, "points"));
@@ -166,7 +166,7 @@ TEST(InspectVelodyne, EveryRejectionIsCountedByReason) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto r = testing::json_lines(run.output);
   EXPECT_EQ(r.size(), 20U);
-  for (const auto& rec : r) EXPECT_EQ(rec["type"].text, "velodyne_data");
+  for (const auto& rec : r) EXPECT_EQ(rec.at("type").get<std::string>(), "velodyne_data");
   for (const char* reason : {"bad_block_flag", "bad_length", "bad_azimuth", "position_bad_length", "other_port",
                              "not_ipv4", "not_udp", "truncated_record"}) {
     EXPECT_EQ(summary_number(run.output, reason), 1) << reason << "\n" << run.output;
@@ -197,8 +197,8 @@ TEST(InspectVelodyne, PacketsWithoutAModelAreRejectedAndPositionsStillPrinted) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto r = testing::json_lines(run.output);
   ASSERT_EQ(r.size(), 1U) << run.output;
-  EXPECT_EQ(r[0]["type"].text, "velodyne_position");
-  EXPECT_NEAR(r[0]["lat_deg"].number, 37.13054, 1e-9);
+  EXPECT_EQ(r[0].at("type").get<std::string>(), "velodyne_position");
+  EXPECT_NEAR(r[0].at("lat_deg").get<double>(), 37.13054, 1e-9);
   EXPECT_EQ(summary_number(run.output, "no_model"), 20);
   EXPECT_NE(run.output.find("  model              undecided"), std::string::npos) << run.output;
 }
@@ -229,7 +229,7 @@ TEST(InspectVelodyne, PortOptionsAndPcapng) {
   ASSERT_EQ(c.exit_code, 0) << c.output;
   const auto rc = testing::json_lines(c.output);
   ASSERT_EQ(rc.size(), 12U);
-  EXPECT_EQ(rc[0]["port"].integer(), 2369);
+  EXPECT_EQ(rc[0].at("port").get<long long>(), 2369);
   EXPECT_NE(c.output.find("data 2369, position 8309"), std::string::npos) << c.output;
 
   for (const char* bad : {"0", "65536", "http", "23x"}) {

@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/json_reader.hpp"
 #include "app/run_command.hpp"
 #include "fieldguard/io/pcap_reader.hpp"
 #include "io/pcap_builder.hpp"
@@ -39,15 +40,15 @@ std::uint16_t free_udp_port() {
   return ntohs(a.sin_port);
 }
 
+// The sample lines of a --samples-out file by their "sensor", each as written (the comparison is byte for byte).
 std::map<std::string, std::vector<std::string>> by_sensor(const std::string& path) {
   std::map<std::string, std::vector<std::string>> m;
   std::ifstream in(path);
   std::string line;
   while (std::getline(in, line)) {
-    const auto at = line.find("\"sensor\":\"");
-    if (at == std::string::npos) continue;
-    const auto end = line.find('"', at + 10);
-    m[line.substr(at + 10, end - at - 10)].push_back(line);
+    const testing::Json j = testing::Json::parse(line, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object() || !j.contains("sensor") || !j.at("sensor").is_string()) continue;
+    m[j.at("sensor").get<std::string>()].push_back(line);
   }
   return m;
 }

@@ -253,16 +253,16 @@ void check_can_log(const std::string& config, const std::string& pcap, const std
   enum class Where { Inside, Far, Between };
   std::vector<Where> where;
   for (std::size_t k = 0; k < truth.size(); ++k) {
-    EXPECT_NEAR(detected[k]["stamp"].number, truth[k]["stamp"].number, 1e-3) << k;
+    EXPECT_NEAR(detected[k].at("stamp").get<double>(), truth[k].at("stamp").get<double>(), 1e-3) << k;
     Where w = Where::Far;
-    for (const auto& o : truth[k]["objects"].items) {
-      if (o["id"].text != "pedestrian") continue;
-      const auto lo = o["min"].numbers();
-      const auto hi = o["max"].numbers();
+    for (const auto& o : truth[k].at("objects")) {
+      if (o.at("id").get<std::string>() != "pedestrian") continue;
+      const auto lo = o.at("min").get<std::vector<double>>();
+      const auto hi = o.at("max").get<std::vector<double>>();
       // Inside: overlapping the zone by more than 0.3 m and seen; far: 1.5 m clear of it.
       const double m = e.inside_margin;
       const bool inside = lo[0] < zx1 - m && hi[0] > zx0 + m && lo[1] < zy - m && hi[1] > -zy + m &&
-                          o["hits"].number >= 5;
+                          o.at("hits").get<double>() >= 5;
       const double f = e.far_margin;
       const bool far = lo[0] > zx1 + f || hi[0] < zx0 - f || lo[1] > zy + f || hi[1] < -zy - f;
       w = inside ? Where::Inside : (far ? Where::Far : Where::Between);

@@ -82,18 +82,18 @@ class ReplayFusion : public ::testing::Test {
     std::ifstream in(session("pose.truth.jsonl"));
     std::string header;
     std::getline(in, header);
-    const auto parsed = testing::JsonParser(header).parse();
-    ASSERT_TRUE(parsed.has_value()) << header;
-    const Json h = (*parsed)["session"];
-    truth_->field_heading_deg = h["field_heading_deg"].number;
-    for (const Json& o : h["objects"].items) {
-      if (o["id"].text == "pole-1") {
-        truth_->pole_lat = o["base_lat_deg"].number;
-        truth_->pole_lon = o["base_lon_deg"].number;
-        truth_->pole_h = o["base_h_m"].number;
-      } else if (o["id"].text == "box-1") {
-        truth_->box_lat = o["base_lat_deg"].number;
-        truth_->box_lon = o["base_lon_deg"].number;
+    const Json parsed = Json::parse(header, nullptr, /*allow_exceptions=*/false);
+    ASSERT_FALSE(parsed.is_discarded()) << header;
+    const Json h = parsed.at("session");
+    truth_->field_heading_deg = h.at("field_heading_deg").get<double>();
+    for (const Json& o : h.at("objects")) {
+      if (o.at("id").get<std::string>() == "pole-1") {
+        truth_->pole_lat = o.at("base_lat_deg").get<double>();
+        truth_->pole_lon = o.at("base_lon_deg").get<double>();
+        truth_->pole_h = o.at("base_h_m").get<double>();
+      } else if (o.at("id").get<std::string>() == "box-1") {
+        truth_->box_lat = o.at("base_lat_deg").get<double>();
+        truth_->box_lon = o.at("base_lon_deg").get<double>();
       }
     }
   }
@@ -449,8 +449,8 @@ TEST_F(ReplayFusion, LowBoxInFrontOfTheBumperIsFoundFromThe2dScanOnly) {
   const auto box = gk.forward({truth_->box_lat, truth_->box_lon, 0.0});
   ASSERT_TRUE(box.has_value());
   auto in_front = [](const Json& o) {
-    const auto mn = o["min"].numbers();
-    const auto mx = o["max"].numbers();
+    const auto mn = o.at("min").get<std::vector<double>>();
+    const auto mx = o.at("max").get<std::vector<double>>();
     return mn.size() == 3 && mx.size() == 3 && mn[0] < 2.5 && mx[0] > 0.3 && mn[1] < 1.0 && mx[1] > -1.0;
   };
   const auto with_scan = last_frames("--session '" + *session_dir_ + "' --obstacles-out /dev/stdout", 20);
@@ -458,12 +458,12 @@ TEST_F(ReplayFusion, LowBoxInFrontOfTheBumperIsFoundFromThe2dScanOnly) {
   std::size_t found = 0;
   double worst_plane = 0.0;
   for (const Json& f : with_scan) {
-    EXPECT_EQ(f["fusion"]["levelling"].text, "full");
-    for (const Json& o : f["obstacles"].items) {
+    EXPECT_EQ(f.at("fusion").at("levelling").get<std::string>(), "full");
+    for (const Json& o : f.at("obstacles")) {
       if (!in_front(o)) continue;
-      EXPECT_EQ(o["seen_by"].text, "2d") << "the 3D LiDAR cannot see it from 1.8 m up";
+      EXPECT_EQ(o.at("seen_by").get<std::string>(), "2d") << "the 3D LiDAR cannot see it from 1.8 m up";
       ++found;
-      const auto p = o["plane"].numbers();
+      const auto p = o.at("plane").get<std::vector<double>>();
       ASSERT_EQ(p.size(), 3U);
       worst_plane = std::max(worst_plane, std::hypot(p[0] - box->easting_m, p[1] - box->northing_m));
       break;
@@ -475,7 +475,7 @@ TEST_F(ReplayFusion, LowBoxInFrontOfTheBumperIsFoundFromThe2dScanOnly) {
   ASSERT_EQ(without.size(), 20U);
   std::size_t found_without = 0;
   for (const Json& f : without) {
-    for (const Json& o : f["obstacles"].items) found_without += in_front(o) ? 1U : 0U;
+    for (const Json& o : f.at("obstacles")) found_without += in_front(o) ? 1U : 0U;
   }
   std::printf("low box 1 m in front of the bumper: found in %zu of the last 20 frames with the 2D scan (its footprint "
               "within %.2f m of the truth's centre on the plane), %zu without it\n",
@@ -520,10 +520,11 @@ TEST(DetectionPose, IsTheLidarsPlaceAndHeadingForAFrameLevelledInFull) {
   r.obstacles.push_back(o);
   LidarFrame frame;
   const std::string line = obstacles_json_line(frame, r, &f, &lidar);
-  const auto at = line.find("\"plane\":[");
-  ASSERT_NE(at, std::string::npos) << line;
-  double e = 0.0, n = 0.0, u = 0.0;
-  ASSERT_EQ(std::sscanf(line.c_str() + at + 9, "%lf,%lf,%lf", &e, &n, &u), 3) << line;
+  const Json j = Json::parse(line, nullptr, /*allow_exceptions=*/false);
+  ASSERT_TRUE(j.is_object() && j.at("obstacles").size() == 1 && j.at("obstacles").at(0).contains("plane")) << line;
+  const auto plane = j.at("obstacles").at(0).at("plane").get<std::vector<double>>();
+  ASSERT_EQ(plane.size(), 3U) << line;
+  const double e = plane[0], n = plane[1], u = plane[2];
   const double c = std::cos(q->yaw_rad), s = std::sin(q->yaw_rad);
   EXPECT_NEAR(e, q->x_m + c * 11.5 - s * -2.5, 1e-3);
   EXPECT_NEAR(n, q->y_m + s * 11.5 + c * -2.5, 1e-3);

@@ -378,13 +378,13 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   std::vector<Where> where;
   for (const auto& t : truth) {
     Where w = Where::Far;
-    for (const auto& o : t["objects"].items) {
-      if (o["id"].text != "pedestrian") continue;
-      const auto lo = o["min"].numbers();
-      const auto hi = o["max"].numbers();
+    for (const auto& o : t.at("objects")) {
+      if (o.at("id").get<std::string>() != "pedestrian") continue;
+      const auto lo = o.at("min").get<std::vector<double>>();
+      const auto hi = o.at("max").get<std::vector<double>>();
       const double m = 0.1;  // in by 10 cm, and seen
       const bool inside =
-          lo[0] < zx1 - m && hi[0] > zx0 + m && lo[1] < zy - m && hi[1] > -zy + m && o["hits"].number >= 5;
+          lo[0] < zx1 - m && hi[0] > zx0 + m && lo[1] < zy - m && hi[1] > -zy + m && o.at("hits").get<double>() >= 5;
       const double f = 0.05;
       const bool far = lo[0] > zx1 + f || hi[0] < zx0 - f || lo[1] > zy + f || hi[1] < -zy - f;
       w = inside ? Where::Inside : (far ? Where::Far : Where::Between);
