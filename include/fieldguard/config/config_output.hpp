@@ -30,7 +30,7 @@ struct RealtimeConfig {
   std::vector<int> io_cpus;                 // CPU affinity of the io thread; empty: any
   std::vector<int> worker_cpus;             // CPU affinity of the perception workers; empty: any
   bool lock_memory = false;                 // mlockall(MCL_CURRENT | MCL_FUTURE)
-  double latency_budget_ms = 10.0;          // a frame decided later than this after its last packet counts as late
+  double latency_budget_ms = 10.0;          // a frame decided later than this after it was whole counts as late
 };
 
 enum class CanSinkKind : std::uint8_t { SocketCan, Candump, None };
