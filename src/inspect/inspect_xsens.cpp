@@ -42,7 +42,7 @@ std::string utc_string(const xs::UtcTime& t) {
   return s + "Z";
 }
 
-std::string pvt_json(const xs::GnssPvt& p) {
+JsonLine pvt_json(const xs::GnssPvt& p) {
   JsonLine j;
   j.field("itow_ms", p.itow_ms).field("year", p.year).field("month", p.month).field("day", p.day);
   j.field("hour", p.hour).field("min", p.min).field("sec", p.sec).field("valid", p.valid);
@@ -57,22 +57,16 @@ std::string pvt_json(const xs::GnssPvt& p) {
   j.field("head_veh_1e5deg", p.head_veh_1e5deg);
   j.field("gdop", p.gdop).field("pdop", p.pdop).field("tdop", p.tdop).field("vdop", p.vdop);
   j.field("hdop", p.hdop).field("ndop", p.ndop).field("edop", p.edop);
-  return std::move(j).str();
+  return j;
 }
 
-std::string sat_info_json(const xs::GnssSatInfo& s) {
+JsonLine sat_info_json(const xs::GnssSatInfo& s) {
   JsonLine j;
   j.field("itow_ms", s.itow_ms).field("num_svs", s.num_svs);
-  std::string sats = "[";
-  for (const auto& sv : s.satellites) {
-    if (sats.size() > 1) sats += ',';
-    std::array<char, 64> buf{};
-    std::snprintf(buf.data(), buf.size(), "[%u,%u,%u,%u]", unsigned{sv.gnss_id}, unsigned{sv.sv_id},
-                  unsigned{sv.cno_dbhz}, unsigned{sv.flags});
-    sats += buf.data();
-  }
-  j.raw("satellites", sats + "]");  // [gnss_id, sv_id, cno_dbhz, flags] each
-  return std::move(j).str();
+  JsonLine::Json sats = JsonLine::Json::array();
+  for (const auto& sv : s.satellites) sats.push_back(JsonLine::Json::array({sv.gnss_id, sv.sv_id, sv.cno_dbhz, sv.flags}));
+  j.value("satellites", std::move(sats));  // [gnss_id, sv_id, cno_dbhz, flags] each
+  return j;
 }
 
 std::string record(const xs::MtData2& d) {
@@ -113,16 +107,9 @@ std::string record(const xs::MtData2& d) {
     put(j, "vel_mps", d.velocity_mps);
     j.field("vel_frame", xs::to_string(d.velocity_frame));
   }
-  if (d.gnss_pvt) j.raw("gnss_pvt", pvt_json(*d.gnss_pvt));
-  if (d.gnss_sat_info) j.raw("gnss_sat_info", sat_info_json(*d.gnss_sat_info));
-  if (!d.unknown_ids.empty()) {
-    std::string ids = "[";
-    for (const auto id : d.unknown_ids) {
-      if (ids.size() > 1) ids += ',';
-      ids += std::to_string(id);
-    }
-    j.raw("unknown_data_ids", ids + "]");
-  }
+  if (d.gnss_pvt) j.object("gnss_pvt", pvt_json(*d.gnss_pvt));
+  if (d.gnss_sat_info) j.object("gnss_sat_info", sat_info_json(*d.gnss_sat_info));
+  if (!d.unknown_ids.empty()) j.value("unknown_data_ids", d.unknown_ids);
   return std::move(j).str();
 }
 

@@ -1,115 +1,78 @@
 #pragma once
-// One JSON object on one line, built field by field (private to the app module). Numbers: integers as they
-// are, doubles in the shortest form that reads back to the same double (std::to_chars), non-finite as null.
+// One JSON object on one line, built field by field on nlohmann::ordered_json (private to the inspect module).
+// Keys stay in the order they are added. Numbers: integers as they are, doubles in nlohmann's shortest form
+// that reads back to the same double (a whole number keeps its ".0": 90.0), non-finite as null. Strings are
+// bytes out of a capture, not text: each byte is one character (ISO 8859-1), so whatever is not printable
+// ASCII comes out escaped (\u00XX, \n, ...) and reads back as the same byte, and the line is always valid JSON.
 
-#include <array>
-#include <charconv>
-#include <cmath>
 #include <concepts>
-#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
+
+#include <nlohmann/json.hpp>
 
 namespace fieldguard::app {
 
 class JsonLine {
  public:
-  JsonLine() : s_("{") {}
+  using Json = nlohmann::ordered_json;
 
-  JsonLine& null(std::string_view k) {
-    key(k);
-    s_ += "null";
-    return *this;
-  }
-  JsonLine& field(std::string_view k, double v) {
-    key(k);
-    number(v);
-    return *this;
-  }
+  JsonLine& null(std::string_view k) { return set(k, nullptr); }
+  JsonLine& field(std::string_view k, double v) { return set(k, v); }
   template <std::integral T>
+    requires(!std::same_as<T, bool>)
   JsonLine& field(std::string_view k, T v) {
-    key(k);
-    std::array<char, 24> buf{};
-    const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-    s_.append(buf.data(), r.ptr);
-    return *this;
+    return set(k, v);
   }
-  JsonLine& field(std::string_view k, std::string_view v) {
-    key(k);
-    string(v);
-    return *this;
-  }
+  JsonLine& field(std::string_view k, std::string_view v) { return set(k, bytes(v)); }
   JsonLine& field(std::string_view k, const char* v) { return field(k, std::string_view(v)); }
   template <typename T>
   JsonLine& field(std::string_view k, const std::optional<T>& v) {
     return v ? field(k, *v) : null(k);
   }
-  JsonLine& boolean(std::string_view k, bool v) {
-    key(k);
-    s_ += v ? "true" : "false";
-    return *this;
-  }
+  JsonLine& boolean(std::string_view k, bool v) { return set(k, v); }
   // A one-letter code ('A', 'D', ...) as a string; null for 0 (absent).
   JsonLine& letter(std::string_view k, char c) { return c == 0 ? null(k) : field(k, std::string_view(&c, 1)); }
   JsonLine& array(std::string_view k, std::span<const double> v) {
-    key(k);
-    s_ += '[';
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      if (i > 0) s_ += ',';
-      number(v[i]);
+    Json a = Json::array();
+    for (const double x : v) a.push_back(x);
+    return set(k, std::move(a));
+  }
+  // A nested object, built with its own JsonLine.
+  JsonLine& object(std::string_view k, JsonLine&& v) { return set(k, std::move(v.j_)); }
+  // Any other value (arrays of integers, arrays of arrays), built with nlohmann directly. Strings in it are
+  // taken as UTF-8: pass capture bytes through bytes() first.
+  JsonLine& value(std::string_view k, Json v) { return set(k, std::move(v)); }
+
+  // The object as one line, without the newline; the JsonLine is spent.
+  [[nodiscard]] std::string str() && { return j_.dump(-1, ' ', /*ensure_ascii=*/true); }
+
+  // Capture bytes as a JSON string's UTF-8: byte b is the character U+00bb.
+  static std::string bytes(std::string_view v) {
+    std::string s;
+    s.reserve(v.size());
+    for (const char c : v) {
+      const auto u = static_cast<unsigned char>(c);
+      if (u < 0x80) {
+        s += c;
+      } else {
+        s += static_cast<char>(0xC0 | (u >> 6));
+        s += static_cast<char>(0x80 | (u & 0x3F));
+      }
     }
-    s_ += ']';
-    return *this;
-  }
-  // A value that is already JSON (a nested object or array).
-  JsonLine& raw(std::string_view k, std::string_view json) {
-    key(k);
-    s_ += json;
-    return *this;
-  }
-
-  // The object, closed; the JsonLine is spent.
-  [[nodiscard]] std::string str() && {
-    s_ += '}';
-    return std::move(s_);
-  }
-
-  static std::string format(double v) {
-    if (!std::isfinite(v)) return "null";
-    std::array<char, 32> buf{};
-    const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), v);
-    return std::string(buf.data(), r.ptr);
+    return s;
   }
 
  private:
-  void key(std::string_view k) {
-    if (s_.size() > 1) s_ += ',';
-    string(k);
-    s_ += ':';
-  }
-  void number(double v) { s_ += format(v); }
-  void string(std::string_view v) {
-    s_ += '"';
-    for (const char c : v) {
-      const auto u = static_cast<unsigned char>(c);
-      if (c == '"' || c == '\\') {
-        s_ += '\\';
-        s_ += c;
-      } else if (u < 0x20 || u >= 0x7F) {
-        constexpr std::string_view kHex = "0123456789abcdef";
-        s_ += "\\u00";
-        s_ += kHex[u >> 4];
-        s_ += kHex[u & 0x0F];
-      } else {
-        s_ += c;
-      }
-    }
-    s_ += '"';
+  JsonLine& set(std::string_view k, Json v) {
+    j_[bytes(k)] = std::move(v);  // keys too: SCIP info labels come from the sensor
+    return *this;
   }
 
-  std::string s_;
+  Json j_ = Json::object();
 };
 
 }  // namespace fieldguard::app
