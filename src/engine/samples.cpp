@@ -1,17 +1,10 @@
 #include "fieldguard/engine/samples.hpp"
 
-#include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <optional>
 #include <string>
-#include <type_traits>
 #include <variant>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "fieldguard/drivers/nmea_stream.hpp"
 #include "fieldguard/drivers/scip_session.hpp"
@@ -36,30 +29,12 @@ struct Digest {
   }
 };
 
-using Json = nlohmann::ordered_json;  // keys in the order they are written
-
-// A measured value to 9 significant digits (%.9g: what the sensors' fields carry, not the double's noise), a
-// whole number as an integer, non-finite as null. nlohmann mostly writes that as %.9g would (52.3, 90, 1e-05),
-// but not always: its Grisu2 does not always find the shortest digits, and about one value in 370 comes out
-// as 16 or 17 digits of the same double (0.6568609479999999 for 0.656860948; read back, the same number).
-// Also -0 is written 0, and a magnitude from 1e9 to 1e15 with all its digits rather than %.9g's exponent.
-Json num(double v) {
-  if (!std::isfinite(v)) return nullptr;
+std::string num(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.9g", v);
-  const double r = std::strtod(buf, nullptr);
-  if (r == std::trunc(r) && std::abs(r) < 1e15) return static_cast<std::int64_t>(r);
-  return r;
+  return buf;
 }
-template <typename T>
-Json opt(const std::optional<T>& v) {
-  if (!v) return nullptr;
-  if constexpr (std::is_floating_point_v<T>) {
-    return num(*v);
-  } else {
-    return *v;
-  }
-}
+std::string opt(const std::optional<double>& v) { return v ? num(*v) : "null"; }
 
 }  // namespace
 
@@ -96,10 +71,8 @@ struct SampleDecoder::Impl {
   std::vector<xsens::StreamItem> items;
   SampleCounts counts;
 
-  // One sample, one line. Strings that are not UTF-8 (a talker of garbage bytes) have those bytes replaced
-  // by U+FFFD rather than stop the recording.
-  void line(const Json& j) const {
-    if (out != nullptr) *out << j.dump(-1, ' ', false, Json::error_handler_t::replace) << '\n';
+  void line(const std::string& s) const {
+    if (out != nullptr) *out << s << '\n';
   }
 
   void emit_frames() {
@@ -107,12 +80,9 @@ struct SampleDecoder::Impl {
       Digest d;
       for (const auto& p : f.points) d.add(&p, sizeof p);
       ++counts.lidar_frames;
-      line({{"sensor", "lidar"},
-            {"frame", f.index},
-            {"stamp_ns", f.host_stamp.ns},
-            {"partial", f.partial},
-            {"points", f.points.size()},
-            {"digest", d.hex()}});
+      line("{\"sensor\":\"lidar\",\"frame\":" + std::to_string(f.index) + ",\"stamp_ns\":" + std::to_string(f.host_stamp.ns) +
+           ",\"partial\":" + (f.partial ? "true" : "false") + ",\"points\":" + std::to_string(f.points.size()) +
+           ",\"digest\":\"" + d.hex() + "\"}");
       stream.recycle(std::move(f));
     }
     frames.clear();
@@ -121,26 +91,19 @@ struct SampleDecoder::Impl {
   void emit_sentences() {
     for (const auto& s : sentences) {
       ++counts.gnss;
-      Json l = {{"sensor", "gnss"}};
+      std::string l = "{\"sensor\":\"gnss\"";
       if (const auto* g = std::get_if<nmea::Gga>(&s)) {
-        l["type"] = g->talker + "GGA";
-        l["time"] = opt(g->utc_seconds_of_day);
-        l["lat_deg"] = opt(g->lat_deg);
-        l["lon_deg"] = opt(g->lon_deg);
-        l["alt_m"] = opt(g->alt_m);
-        l["quality"] = opt(g->quality);
+        l += ",\"type\":\"" + g->talker + "GGA\",\"time\":" + opt(g->utc_seconds_of_day) + ",\"lat_deg\":" + opt(g->lat_deg) +
+             ",\"lon_deg\":" + opt(g->lon_deg) + ",\"alt_m\":" + opt(g->alt_m) +
+             ",\"quality\":" + (g->quality ? std::to_string(*g->quality) : "null");
       } else if (const auto* r = std::get_if<nmea::Rmc>(&s)) {
-        l["type"] = r->talker + "RMC";
-        l["time"] = opt(r->utc_seconds_of_day);
-        l["valid"] = r->valid;
-        l["lat_deg"] = opt(r->lat_deg);
-        l["lon_deg"] = opt(r->lon_deg);
-        l["speed_mps"] = opt(r->speed_mps);
+        l += ",\"type\":\"" + r->talker + "RMC\",\"time\":" + opt(r->utc_seconds_of_day) + ",\"valid\":" +
+             (r->valid ? "true" : "false") + ",\"lat_deg\":" + opt(r->lat_deg) + ",\"lon_deg\":" + opt(r->lon_deg) +
+             ",\"speed_mps\":" + opt(r->speed_mps);
       } else {
-        l["type"] = "other";
-        l["index"] = s.index();
+        l += ",\"type\":\"other\",\"index\":" + std::to_string(s.index());
       }
-      line(l);
+      line(l + "}");
     }
     sentences.clear();
   }
@@ -150,9 +113,13 @@ struct SampleDecoder::Impl {
       const auto* m = std::get_if<xsens::MtData2>(&it);
       if (m == nullptr) continue;
       ++counts.ahrs;
-      Json l = {{"sensor", "ahrs"}, {"packet_counter", opt(m->packet_counter)}, {"sample_time_fine", opt(m->sample_time_fine)}};
-      if (m->euler_deg) l["euler_deg"] = Json::array({num(m->euler_deg->x), num(m->euler_deg->y), num(m->euler_deg->z)});
-      line(l);
+      std::string l = "{\"sensor\":\"ahrs\",\"packet_counter\":" +
+                      (m->packet_counter ? std::to_string(*m->packet_counter) : std::string("null")) +
+                      ",\"sample_time_fine\":" + (m->sample_time_fine ? std::to_string(*m->sample_time_fine) : std::string("null"));
+      if (m->euler_deg) {
+        l += ",\"euler_deg\":[" + num(m->euler_deg->x) + "," + num(m->euler_deg->y) + "," + num(m->euler_deg->z) + "]";
+      }
+      line(l + "}");
     }
     items.clear();
   }
@@ -169,10 +136,8 @@ void SampleDecoder::lidar(const io::UdpDatagram& d) {
     auto p = velodyne::decode_position_packet(d.payload);
     if (!p) return;
     ++impl_->counts.lidar_positions;
-    impl_->line({{"sensor", "lidar_position"},
-                 {"timestamp_us", p->timestamp_us},
-                 {"pps", velodyne::to_string(p->pps)},
-                 {"rmc", p->rmc.has_value()}});
+    impl_->line("{\"sensor\":\"lidar_position\",\"timestamp_us\":" + std::to_string(p->timestamp_us) + ",\"pps\":\"" +
+                std::string(velodyne::to_string(p->pps)) + "\",\"rmc\":" + (p->rmc ? "true" : "false") + "}");
   }
 }
 
@@ -189,11 +154,9 @@ void SampleDecoder::scan2d(ByteSpan bytes, bool to_sensor) {
     d.add(s.ranges_mm.data(), s.ranges_mm.size() * sizeof(s.ranges_mm[0]));
     d.add(s.intensities.data(), s.intensities.size() * sizeof(s.intensities[0]));
     ++impl_->counts.scans;
-    impl_->line({{"sensor", "scan2d"},
-                 {"timestamp_ms", s.timestamp_ms},
-                 {"first_step", s.first_step},
-                 {"values", s.ranges_mm.size()},
-                 {"digest", d.hex()}});
+    impl_->line("{\"sensor\":\"scan2d\",\"timestamp_ms\":" + std::to_string(s.timestamp_ms) + ",\"first_step\":" +
+                std::to_string(s.first_step) + ",\"values\":" + std::to_string(s.ranges_mm.size()) + ",\"digest\":\"" +
+                d.hex() + "\"}");
   }
 }
 
