@@ -4,6 +4,7 @@
 #include "app/commands.hpp"
 
 #include <charconv>
+#include <cstdlib>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -258,7 +259,16 @@ Command add_record(CLI::App& top) {
   cmd->add_option("--config", opt->config, kConfigHelp)->type_name("FILE");
   cmd->add_option("--out", opt->out, "the session directory (created when missing)")->type_name("DIR");
   cmd->add_option("--duration", opt->duration, "stop after this many seconds (default: at a signal)")
-      ->type_name("SECONDS");
+      ->type_name("SECONDS")
+      ->check(CLI::Validator(
+          [](const std::string& text) {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            return end != text.c_str() && *end == '\0' && v > 0.0 && v < 1e9
+                       ? std::string()
+                       : "takes a number of seconds above 0, not '" + text + "'";
+          },
+          "> 0"));
   cmd->add_option("--samples-out", opt->samples_out,
                   "also decode live and write every sample as a JSON line (what replay --samples-out\n"
                   "writes from the recording)")

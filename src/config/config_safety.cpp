@@ -45,7 +45,7 @@ void read_sensors(YamlReader& r, const YAML::Node& n, output::safety::Params& p)
   for (std::size_t i = 0; i < output::safety::kSensorCount; ++i) {
     const auto s = static_cast<Sensor>(i);
     const std::string name(to_string(s));
-    const std::string sp = path + "." + name;
+    const std::string sp = join_path(path, name.c_str());
     const YAML::Node sn = n[name];
     if (!r.section(sn, sp, {"required", "timeout_s"})) continue;
     read_bool(r, sn, sp, "required", p.sensor(s).required);
@@ -124,10 +124,10 @@ void read_safety(YamlReader& r, const YAML::Node& n, Config& c) {
                {Sensor::Ahrs, c.ahrs.serial.enabled, "ahrs"}};
   for (const auto& l : links) {
     if (p.sensor(l.sensor).required && !l.enabled) {
-      const std::string key = "sensors." + std::string(to_string(l.sensor)) + ".required";
-      r.issue(node_at(n, key), path + "." + key,
-              std::string("the sensor is required but ") + l.section + ".enabled is false; the tractor would never " +
-                  "start: enable " + l.section + " or set required to false");
+      const std::string key = std::string("sensors.").append(to_string(l.sensor)).append(".required");
+      r.issue(node_at(n, key), join_path(path, key.c_str()),
+              std::string("the sensor is required but ").append(l.section).append(".enabled is false; the tractor would "
+                  "never start: enable ").append(l.section).append(" or set required to false"));
     }
   }
 }

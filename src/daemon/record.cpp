@@ -46,7 +46,7 @@ int record(const RecordOptions& opt) {
     return kExitBadInput;
   }
   double duration_s = 0.0;
-  if (const auto& d = opt.duration) duration_s = std::atof(d->c_str());
+  if (opt.duration) duration_s = *opt.duration;
 
   std::ofstream samples_file;
   if (const auto& s = opt.samples_out) samples_file.open(*s, std::ios::trunc);

@@ -32,7 +32,7 @@ constexpr auto kTick = std::chrono::milliseconds(5);
 // can.sink: none. Frames are counted and go nowhere.
 class NullSink final : public output::CanSink {
  public:
-  void write(std::span<const output::CanFrame> frames, Stamp) override { stats_.sent += frames.size(); }
+  void write(std::span<const output::CanFrame> frames, Stamp /*t*/) override { stats_.sent += frames.size(); }
   [[nodiscard]] const output::CanSinkStats& stats() const override { return stats_; }
 
  private:

@@ -322,7 +322,7 @@ void Session::deliver(const Pool::Result& r) {
     ++lost_;
     if (r.outcome == sync::Outcome::Failed) {
       log_->error("frame {}: detection failed: {}", r.input->synced ? r.input->synced->seq : r.input->rotation.index,
-                  r.error ? *r.error : "?");
+                  r.error != nullptr ? *r.error : "?");
     }
     return;
   }

@@ -188,7 +188,8 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
   const float in_block_last = static_cast<float>(lay.sequences - 1) * lay.sequence_us +
                               static_cast<float>(lay.lasers - 1) * lay.firing_us;
   last_firing_single_us_ = static_cast<float>(kBlocksPerPacket - 1) * lay.block_us + in_block_last;
-  last_firing_dual_us_ = static_cast<float>(kBlocksPerPacket / 2 - 1) * lay.block_us + in_block_last;
+  // Dual return: the packet holds half as many firings (block pairs); the division is exact (12 blocks).
+  last_firing_dual_us_ = static_cast<float>(kBlocksPerPacket / 2 - 1) * lay.block_us + in_block_last;  // NOLINT(bugprone-integer-division)
 
   constexpr double kRadPerDeg = std::numbers::pi / 180.0;
   for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {

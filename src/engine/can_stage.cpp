@@ -35,7 +35,7 @@ output::StopRequest CanStage::request_for(const safety::Decision& d) {
   output::StopRequest r;
   r.command = d.stop ? output::StopCommand::Stop : output::StopCommand::Go;
   if (!d.stop) return r;
-  const std::uint8_t reasons = static_cast<std::uint8_t>(d.reasons | safety::bit(d.reason));
+  const auto reasons = static_cast<std::uint8_t>(d.reasons | safety::bit(d.reason));
   auto has = [&](safety::Reason x) { return (reasons & safety::bit(x)) != 0; };
   r.reasons.obstacle_in_zone = has(safety::Reason::ObstacleInZone);
   // The DBC has no bit of its own for implausible data: to the controller it is a sensor it cannot trust.
@@ -54,7 +54,7 @@ output::Heartbeat CanStage::heartbeat_for(const safety::Params& safety,
   auto health = [&](safety::Sensor s) {
     if (!safety.sensor(s).required) return output::SensorHealth::NotRequired;
     if (!last) return output::SensorHealth::Unknown;
-    const std::uint8_t bad = static_cast<std::uint8_t>(last->fault_sensors | last->implausible_sensors);
+    const auto bad = static_cast<std::uint8_t>(last->fault_sensors | last->implausible_sensors);
     return (bad & safety::bit(s)) != 0 ? output::SensorHealth::Fault : output::SensorHealth::Ok;
   };
   output::Heartbeat h;

@@ -56,7 +56,8 @@ sync::SyncParams sync_params(const Config& cfg, const FusionInputs& in) {
 std::optional<perception::FramePose> detection_pose(const FusionInfo& f, const Mounting& lidar) {
   if (f.levelling != geo::Levelling::Full || !f.reference || !f.attitude) return std::nullopt;
   const double yaw = f.attitude->yaw_deg * (std::numbers::pi / 180.0);
-  const double c = std::cos(yaw), s = std::sin(yaw);
+  const double c = std::cos(yaw);
+  const double s = std::sin(yaw);
   perception::FramePose p;
   p.x_m = f.reference->easting_m + c * lidar.x_m - s * lidar.y_m;
   p.y_m = f.reference->northing_m + s * lidar.x_m + c * lidar.y_m;

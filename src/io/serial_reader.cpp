@@ -146,7 +146,12 @@ struct SerialReader::Impl : std::enable_shared_from_this<Impl> {
 SerialReader::SerialReader(boost::asio::io_context& io, SerialOptions options, Handler handler, StateHandler on_state)
     : impl_(std::make_shared<Impl>(io, std::move(options), std::move(handler), std::move(on_state))) {}
 
-SerialReader::~SerialReader() { stop(); }
+SerialReader::~SerialReader() {
+  try {
+    stop();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): closing the port failed; nothing is left to do with it
+  }
+}
 
 void SerialReader::start() {
   if (impl_->running) return;

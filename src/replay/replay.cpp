@@ -387,7 +387,7 @@ void Replay::decide(const Pool::Result& r, const LidarFrame& f, perception::Fram
       output::safety::Sensor::Scan2d, output::safety::Sensor::Gnss, output::safety::Sensor::Ahrs};
   for (std::size_t i = 0; i < heard_.size(); ++i) {
     const Stamp t = heard_[i].at(r.input->complete);
-    if (t.ns != 0) can_->sensor_data(kHeardSensor[i], t);
+    if (t.ns != 0) can_->sensor_data(kHeardSensor[i], t);  // NOLINT(clang-analyzer-core.CallAndMessage): i < 3
   }
   while (!problems_.empty() && problems_.front().at.ns <= r.input->complete.ns) {
     can_->sensor_problem(problems_.front().sensor, problems_.front().problem);

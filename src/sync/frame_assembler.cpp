@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <type_traits>
 
 namespace fieldguard::sync {
 namespace {
@@ -15,7 +16,7 @@ std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s *
 
 // Inserts keeping the deque sorted by time; equal times keep arrival order.
 template <typename T>
-void insert_sorted(std::deque<T>& d, T&& v) {
+void insert_sorted(std::deque<T>& d, std::type_identity_t<T>&& v) {  // v: an rvalue, moved in
   if (d.empty() || d.back().time <= v.time) {
     d.push_back(std::move(v));
     return;

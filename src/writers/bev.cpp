@@ -78,8 +78,8 @@ void draw_obstacles(Image& img, std::span<const perception::Obstacle> obstacles,
     const double sy = std::sin(static_cast<double>(o.obb_yaw_rad));
     const double hl = static_cast<double>(o.obb_length_m) / 2.0;
     const double hw = static_cast<double>(o.obb_width_m) / 2.0;
-    const double cx0 = static_cast<double>(o.obb_center[0]);
-    const double cy0 = static_cast<double>(o.obb_center[1]);
+    const auto cx0 = static_cast<double>(o.obb_center[0]);
+    const auto cy0 = static_cast<double>(o.obb_center[1]);
     const double corners[4][2] = {{hl, hw}, {-hl, hw}, {-hl, -hw}, {hl, -hw}};
     for (int i = 0; i < 4; ++i) {
       const auto& a = corners[i];
@@ -89,7 +89,8 @@ void draw_obstacles(Image& img, std::span<const perception::Obstacle> obstacles,
     }
     char label[32];
     std::snprintf(label, sizeof label, "%.1fm", static_cast<double>(o.distance_m));
-    const int col = p.col(static_cast<double>(o.max[1])), row = p.row(static_cast<double>(o.max[0]));
+    const int col = p.col(static_cast<double>(o.max[1]));
+    const int row = p.row(static_cast<double>(o.max[0]));
     img.text(col, row - 9, label, {255, 255, 255});
     if (o.held) img.text(col, row + 1, "held", c);
   }

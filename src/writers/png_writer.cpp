@@ -97,7 +97,7 @@ void Image::text(int x, int y, const std::string& s, Rgb c) {
       if (g.c != ch) continue;
       for (int row = 0; row < 7; ++row) {
         for (int col = 0; col < 5; ++col) {
-          if ((g.rows[static_cast<std::size_t>(row)] >> (4 - col)) & 1U) set(x + col, y + row, c);
+          if (((g.rows[static_cast<std::size_t>(row)] >> (4 - col)) & 1U) != 0U) set(x + col, y + row, c);
         }
       }
       break;

@@ -19,7 +19,7 @@ int run_daemon(const RunOptions& options);
 struct RecordOptions {
   std::string config;
   std::string out;                         // the session directory
-  std::optional<std::string> duration;     // seconds, as given (atof)
+  std::optional<double> duration;          // seconds (> 0); until a signal when not given
   std::optional<std::string> samples_out;  // every decoded sample as a JSON line
 };
 
