@@ -26,13 +26,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/perception/obstacle.hpp"
@@ -121,7 +120,8 @@ sim::FrameTruth truth_frame() {
     o.distance_m = std::hypot(o.box.min.x, o.box.min.y);
     return o;
   };
-  for (int i = 0; i < 6; ++i) t.objects.push_back(object("implement-" + std::to_string(i + 1), sim::ObjectClass::Implement));
+  for (int i = 0; i < 6; ++i)
+    t.objects.push_back(object("implement-" + std::to_string(i + 1), sim::ObjectClass::Implement));
   for (int i = 0; i < 20; ++i) t.terrain.push_back(object("clod-" + std::to_string(i + 1), sim::ObjectClass::Clod));
   return t;
 }
@@ -150,8 +150,8 @@ const char* levelling_name(geo::Levelling l) {
   return "?";
 }
 
-Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameResult& result, const app::FusionInfo* fusion,
-                             const Mounting* lidar) {
+Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameResult& result,
+                             const app::FusionInfo* fusion, const Mounting* lidar) {
   Json j = {{"frame", frame.index},
             {"stamp", fixed(frame.host_stamp.seconds(), 6)},
             {"partial", frame.partial},
@@ -199,7 +199,8 @@ Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameRes
                {"bearing", fixed(o.bearing_deg, 2)},
                {"height", fixed(o.height_above_ground_m, 3)},
                {"class", perception::to_string(o.size_class)}};
-    if ((o.sources & perception::kSeenBy2d) != 0) oj["seen_by"] = (o.sources & perception::kSeenBy3d) != 0 ? "3d+2d" : "2d";
+    if ((o.sources & perception::kSeenBy2d) != 0)
+      oj["seen_by"] = (o.sources & perception::kSeenBy3d) != 0 ? "3d+2d" : "2d";
     if (o.held) oj["held"] = true;
     if (pose) {
       const double x = 0.5 * (static_cast<double>(o.min[0]) + static_cast<double>(o.max[0]));
@@ -237,7 +238,8 @@ Json truth_json_nlohmann(const sim::FrameTruth& t) {
           {"period_s", fixed(t.period_s, 6)},
           {"roll_deg", fixed(t.roll_deg, 3)},
           {"pitch_deg", fixed(t.pitch_deg, 3)},
-          {"sensor_world", Json::array({fixed(t.sensor_world.x, 3), fixed(t.sensor_world.y, 3), fixed(t.sensor_world.z, 3)})},
+          {"sensor_world",
+           Json::array({fixed(t.sensor_world.x, 3), fixed(t.sensor_world.y, 3), fixed(t.sensor_world.z, 3)})},
           {"returns", t.returns},
           {"objects", truth_objects(t.objects)},
           {"terrain", truth_objects(t.terrain)}};

@@ -354,13 +354,12 @@ void BM_CropPipeline(benchmark::State& state) {
   Cloud out;
   std::vector<LidarPoint> scan2d;
   std::uint32_t in_roi = 0;
-  paired(
-      state, "crop: fieldguard.yaml, pipeline call", static_cast<int>(state.range(0)), f.points.size(),
-      [&] {
-        in_roi = crop_box(f.points, roi, p.body, out, scan2d, far);
-        benchmark::DoNotOptimize(out.x.data());
-      },
-      {});
+  paired(state, "crop: fieldguard.yaml, pipeline call", static_cast<int>(state.range(0)), f.points.size(),
+         [&] {
+           in_roi = crop_box(f.points, roi, p.body, out, scan2d, far);
+           benchmark::DoNotOptimize(out.x.data());
+         },
+         {});
   state.counters["kept"] = static_cast<double>(out.size());
   state.counters["in_roi"] = static_cast<double>(in_roi);
 }
@@ -495,13 +494,12 @@ void BM_ClusterPipelineInput(benchmark::State& state) {
   }
   EuclideanClusterer clusterer(p.cluster);
   Clusters out;
-  paired(
-      state, "cluster: fieldguard.yaml, pipeline input", static_cast<int>(state.range(0)), above.size(),
-      [&] {
-        clusterer.extract(above, out);
-        benchmark::DoNotOptimize(out.indices.data());
-      },
-      {});
+  paired(state, "cluster: fieldguard.yaml, pipeline input", static_cast<int>(state.range(0)), above.size(),
+         [&] {
+           clusterer.extract(above, out);
+           benchmark::DoNotOptimize(out.indices.data());
+         },
+         {});
   state.counters["clusters"] = static_cast<double>(out.size());
 }
 void BM_ClusterAbsorb(benchmark::State& state) {
@@ -660,9 +658,10 @@ void BM_PipelineFieldguardNoSurroundings(benchmark::State& state) {
 }
 
 // Packets to obstacles: the UDP payloads of the rotation into velodyne::Stream, the rotation it emits through
-// the fieldguard.yaml pipeline and its hold (which the daemon runs on its io thread, after the worker). The stream and the pipeline live across runs as in the daemon: each run pushes
-// the rotation's packets, and the first packet (azimuth 0) completes the rotation pushed by the run before,
-// which is then processed; frame buffers go back to the stream. One rotation decoded and detected per run.
+// the fieldguard.yaml pipeline and its hold (which the daemon runs on its io thread, after the worker). The stream and
+// the pipeline live across runs as in the daemon: each run pushes the rotation's packets, and the first packet (azimuth
+// 0) completes the rotation pushed by the run before, which is then processed; frame buffers go back to the stream. One
+// rotation decoded and detected per run.
 void BM_PacketsToObstacles(benchmark::State& state) {
   Frame& f = frame(static_cast<int>(state.range(0)));
   velodyne::Stream stream(bench::sim_stream_options());
@@ -920,4 +919,3 @@ int main(int argc, char** argv) {
   print_summary();
   return 0;
 }
-

@@ -4,11 +4,11 @@
 
 #include <benchmark/benchmark.h>
 
-#include <boost/asio/io_context.hpp>
+#include <atomic>
 #include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -149,8 +149,8 @@ LidarFrame rotation(std::uint64_t index, std::int64_t t, std::int64_t period, st
   f.host_stamp = Stamp{t + 700'000};
   f.points.resize(points);
   for (std::size_t i = 0; i < points; ++i) {
-    f.points[i].time_s = static_cast<float>(static_cast<double>(period) * 1e-9 * static_cast<double>(i) /
-                                            static_cast<double>(points));
+    f.points[i].time_s =
+        static_cast<float>(static_cast<double>(period) * 1e-9 * static_cast<double>(i) / static_cast<double>(points));
   }
   return f;
 }

@@ -27,7 +27,6 @@
 //   packets_per_s, ns_per_point, x_line_rate (packets_per_s / the model's single-return packet rate),
 //   ms_per_rotation (rotation inputs: CPU time per iteration = per rotation), points_per_packet.
 #include <benchmark/benchmark.h>
-
 #include <time.h>
 
 #include <cstdint>
@@ -163,8 +162,8 @@ void report(benchmark::State& state, const Input& in, double seconds, std::size_
   state.counters["packets_per_s"] = packets / seconds;
   state.counters["ns_per_point"] = points > 0.0 ? seconds * 1e9 / points : 0.0;
   state.counters["x_line_rate"] = packets / seconds / in.line_rate;
-  state.counters["points_per_packet"] = static_cast<double>(points_per_iteration) /
-                                        static_cast<double>(in.packets.size());
+  state.counters["points_per_packet"] =
+      static_cast<double>(points_per_iteration) / static_cast<double>(in.packets.size());
   if (in.rotation) state.counters["ms_per_rotation"] = seconds * 1e3 / iterations;
 }
 
@@ -259,7 +258,7 @@ void stream_bench(benchmark::State& state, const std::string& name, bool recycle
 }
 void BM_Stream(benchmark::State& state, const std::string& name) { stream_bench(state, name, false); }
 
-#define FG_ON_EVERY_INPUT(fn)                                                \
+#define FG_ON_EVERY_INPUT(fn)                                               \
   BENCHMARK_CAPTURE(fn, monterey_hdl32e, std::string("monterey_hdl32e"));   \
   BENCHMARK_CAPTURE(fn, veloview_vlp16, std::string("veloview_vlp16"));     \
   BENCHMARK_CAPTURE(fn, vlp32file_hdl32e, std::string("vlp32file_hdl32e")); \

@@ -36,7 +36,8 @@ void check_rmc(const nmea::Rmc& r) {
   if (r.speed_mps) check(std::isfinite(*r.speed_mps));
   if (r.course_deg) check(std::isfinite(*r.course_deg));
   check(r.day.has_value() == r.month.has_value() && r.month.has_value() == r.year.has_value());
-  if (r.day) check(*r.day >= 1 && *r.day <= 31 && *r.month >= 1 && *r.month <= 12 && *r.year >= 1980 && *r.year <= 2079);
+  if (r.day)
+    check(*r.day >= 1 && *r.day <= 31 && *r.month >= 1 && *r.month <= 12 && *r.year >= 1980 && *r.year <= 2079);
   check(r.talker.size() <= 2);
 }
 

@@ -75,7 +75,8 @@ bool same(const nmea::Sentence& a, const nmea::Sentence& b) {
   if (a.index() != b.index() || nmea::talker_of(a) != nmea::talker_of(b)) return false;
   if (const auto* g = std::get_if<nmea::Gga>(&a)) {
     const auto& h = std::get<nmea::Gga>(b);
-    return same(g->lat_deg, h.lat_deg) && same(g->lon_deg, h.lon_deg) && same(g->utc_seconds_of_day, h.utc_seconds_of_day);
+    return same(g->lat_deg, h.lat_deg) && same(g->lon_deg, h.lon_deg) &&
+           same(g->utc_seconds_of_day, h.utc_seconds_of_day);
   }
   if (const auto* r = std::get_if<nmea::Rmc>(&a)) {
     const auto& s = std::get<nmea::Rmc>(b);

@@ -35,7 +35,8 @@ struct Decoders {
   std::vector<Decoder> all;
   Decoders() {
     for (auto unit : {DistanceUnitOption::HalfCm, DistanceUnitOption::OneCmGrouped}) {
-      for (auto mode : {std::optional<ReturnMode>{}, std::optional{ReturnMode::Dual}, std::optional{ReturnMode::Last}}) {
+      for (auto mode :
+           {std::optional<ReturnMode>{}, std::optional{ReturnMode::Dual}, std::optional{ReturnMode::Last}}) {
         DecoderOptions o;
         o.calibration = odd_calibration();
         o.distance_unit = unit;
@@ -52,7 +53,8 @@ void check_points(const std::vector<LidarPoint>& pts, const DecoderOptions& o) {
     check(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) && std::isfinite(p.time_s));
     check(p.azimuth_cdeg < 36000);
     check(p.ring < kChannels);
-    check(p.range_m >= static_cast<float>(o.min_range_m) - 1e-3F && p.range_m <= static_cast<float>(o.max_range_m) + 1e-3F);
+    check(p.range_m >= static_cast<float>(o.min_range_m) - 1e-3F &&
+          p.range_m <= static_cast<float>(o.max_range_m) + 1e-3F);
     check(p.time_s >= 0.F && p.time_s <= kMaxTimeS);
     check(p.intensity >= 0.F && p.intensity <= 255.F);
     const float norm = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);

@@ -1,7 +1,6 @@
 #include "fieldguard/app/cli.hpp"
 
 #include <CLI/CLI.hpp>
-
 #include <cstdio>
 #include <exception>
 #include <map>

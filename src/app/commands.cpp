@@ -4,8 +4,8 @@
 #include "app/commands.hpp"
 
 #include <charconv>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,9 +55,10 @@ int usage_error(const CLI::App& cmd, const std::string& why) {
 
 Command add_check_config(CLI::App& top) {
   auto files = std::make_shared<std::vector<std::string>>();
-  CLI::App* cmd = subcommand(top, "check-config", "validate a configuration file and list every problem",
-                             "Loads FILE as a fieldguard configuration and reports every problem at once, each as\n"
-                             "FILE:LINE: key.path: what is wrong and what to do. Exit code 0 when valid, 2 otherwise.\n");
+  CLI::App* cmd =
+      subcommand(top, "check-config", "validate a configuration file and list every problem",
+                 "Loads FILE as a fieldguard configuration and reports every problem at once, each as\n"
+                 "FILE:LINE: key.path: what is wrong and what to do. Exit code 0 when valid, 2 otherwise.\n");
   cmd->add_option("FILE", *files, "the configuration file");
   return {cmd, "fieldguard check-config FILE", [cmd, files] {
             if (const auto why = leftover(*cmd); !why.empty()) return usage_error(*cmd, why);
@@ -154,8 +155,8 @@ Command add_replay(CLI::App& top) {
               // 1..64: sync::PoolParams' limits.
               opt->workers = whole_number(**workers, 1, 64);
               if (!opt->workers) {
-                return usage_error(*cmd, "--workers takes a whole number of worker threads from 1 to 64, got '" +
-                                             **workers + "'");
+                return usage_error(
+                    *cmd, "--workers takes a whole number of worker threads from 1 to 64, got '" + **workers + "'");
               }
             }
             return replay(*opt);
@@ -229,14 +230,14 @@ Command add_inspect(CLI::App& top) {
               return usage_error(*cmd, files->empty() ? "no capture file given" : "more than one file: " + (*files)[1]);
             }
             opt->path = files->front();
-            const std::pair<const char*, const std::optional<std::string>&> ports[] = {{"data-port", *data_port},
-                                                                                      {"position-port", *position_port}};
+            const std::pair<const char*, const std::optional<std::string>&> ports[] = {
+                {"data-port", *data_port}, {"position-port", *position_port}};
             for (const auto& [name, text] : ports) {
               if (!text) continue;
               const auto port = whole_number(*text, 1, 65535);
               if (!port) {
-                return usage_error(*cmd, std::string("--") + name + " wants a UDP port number 1..65535, not '" +
-                                             *text + "'");
+                return usage_error(*cmd,
+                                   std::string("--") + name + " wants a UDP port number 1..65535, not '" + *text + "'");
               }
               (name == ports[0].first ? opt->data_port : opt->position_port) = static_cast<std::uint16_t>(*port);
             }

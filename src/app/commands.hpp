@@ -3,7 +3,6 @@
 // them to the options of its module; after a successful parse, `run` calls that module. Private to app.
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <string>
 
@@ -13,7 +12,7 @@ namespace fieldguard::app {
 // that CLI11 cannot express (one of two options, ...) come first and return kExitBadInput through `usage_error`.
 struct Command {
   CLI::App* app = nullptr;
-  std::string usage;                  // the synopsis line(s) after "usage: "
+  std::string usage;  // the synopsis line(s) after "usage: "
   std::function<int()> run;
 };
 

@@ -11,9 +11,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "config/section_readers.hpp"
 #include "config/config_safety.hpp"
 #include "config/config_sensors.hpp"
+#include "config/section_readers.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace fieldguard::app {
@@ -80,7 +80,8 @@ void read_lidar(YamlReader& r, const YAML::Node& n, const std::string& config_di
   r.port(n, path, "data_port", c.data_port);
   r.port(n, path, "position_port", c.position_port);
   if (auto t = r.choice(n, path, "timestamp_reference", {"first_firing", "last_firing"})) {
-    c.timestamp_reference = *t == 0 ? velodyne::TimestampReference::FirstFiring : velodyne::TimestampReference::LastFiring;
+    c.timestamp_reference =
+        *t == 0 ? velodyne::TimestampReference::FirstFiring : velodyne::TimestampReference::LastFiring;
   }
   r.number(n, path, "min_range_m", c.min_range_m, 0.0, 300.0, "m");
   r.number(n, path, "max_range_m", c.max_range_m, 0.0, 300.0, "m");
@@ -175,8 +176,7 @@ void read_zones(YamlReader& r, const YAML::Node& z, perception::ZoneParams& p) {
   if (!r.section(z, path,
                  {"edges_m", "rings", "sectors", "min_bin_points", "seed_lowest", "seed_margin_m", "fit_distance_m",
                   "fit_iterations", "ground_threshold_m", "max_slope_deg", "max_tilt_deg", "max_step_m",
-                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m", "blend_radial",
-                  "max_below_m"})) {
+                  "max_slope_change_deg", "min_spread_m", "max_extrapolation_m", "blend_radial", "max_below_m"})) {
     return;
   }
   // The lists are checked against each other only when each was read (a bad list has its own issue).
@@ -237,12 +237,27 @@ void read_ground(YamlReader& r, const YAML::Node& g, perception::GroundParams& p
 void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams& p) {
   const std::string path = "perception.cluster";
   if (!r.section(c, path,
-                 {"method", "structure", "tolerance_m", "beam_spacing_deg", "beam_factor", "max_tolerance_m",
-                  "horizontal_beam_factor", "horizontal_max_tolerance_m", "absorb_max_points", "absorb_margin_m",
-                  "join_float_height_m", "join_fragment_factor", "join_fragment_gap_m", "join_gap_m", "join_stacked",
+                 {"method",
+                  "structure",
+                  "tolerance_m",
+                  "beam_spacing_deg",
+                  "beam_factor",
+                  "max_tolerance_m",
+                  "horizontal_beam_factor",
+                  "horizontal_max_tolerance_m",
+                  "absorb_max_points",
+                  "absorb_margin_m",
+                  "join_float_height_m",
+                  "join_fragment_factor",
+                  "join_fragment_gap_m",
+                  "join_gap_m",
+                  "join_stacked",
                   "join_stack_margin_m",
-                  "split_min_length_m", "split_min_part_m", "split_gap_ratio",
-                  "split_min_part_points", "split_full_range_m"})) {
+                  "split_min_length_m",
+                  "split_min_part_m",
+                  "split_gap_ratio",
+                  "split_min_part_points",
+                  "split_full_range_m"})) {
     return;
   }
   if (auto m = r.choice(c, path, "method", {"fixed", "adaptive", "anisotropic"})) {
@@ -276,13 +291,16 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
   const auto check_growth = [&](const char* cap_key, double cap, const char* factor_key, double factor,
                                 const char* which) {
     if (cap < p.tolerance_m) {
-      r.issue(value_or(c, cap_key), path + "." + cap_key,
-              std::string("must not be less than tolerance_m; the ") + which + " radius grows from tolerance_m up to it");
+      r.issue(
+          value_or(c, cap_key), path + "." + cap_key,
+          std::string("must not be less than tolerance_m; the ") + which + " radius grows from tolerance_m up to it");
     }
     if (factor * std::tan(p.beam_spacing_deg * std::numbers::pi / 180.0) >= 0.5) {
       r.issue(value_or(c, factor_key), path + "." + factor_key,
-              std::string(factor_key) + " * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a "
-              "metre per metre of range); lower " + factor_key);
+              std::string(factor_key) +
+                  " * tan(beam_spacing_deg) must be below 0.5 (the radius would grow half a "
+                  "metre per metre of range); lower " +
+                  factor_key);
     }
   };
   if (p.method == perception::ClusterMethod::Anisotropic) {
@@ -391,8 +409,9 @@ LoadResult load(const std::string& text, const std::string& name, const std::str
     result.issues.push_back({name, 0, "", "the file is empty; start from config/fieldguard.yaml"});
     return result;
   }
-  if (r.section(root, "", {"lidar", "scan2d", "gnss", "ahrs", "sync", "geo", "perception", "safety", "pipeline", "realtime",
-                             "can"})) {
+  if (r.section(
+          root, "",
+          {"lidar", "scan2d", "gnss", "ahrs", "sync", "geo", "perception", "safety", "pipeline", "realtime", "can"})) {
     read_lidar(r, root["lidar"], config_dir, result.config.lidar);
     read_scan2d(r, root["scan2d"], result.config.scan2d);
     read_gnss(r, root["gnss"], result.config.gnss);
@@ -431,7 +450,8 @@ LoadResult load_config_file(const std::string& path) {
     LoadResult r;
     r.config.source_file = path;
     std::error_code ec;
-    const char* why = !fs::exists(path, ec)       ? "no such file; give the path of a fieldguard YAML file (see config/fieldguard.yaml)"
+    const char* why = !fs::exists(path, ec)
+                          ? "no such file; give the path of a fieldguard YAML file (see config/fieldguard.yaml)"
                       : fs::is_directory(path, ec) ? "is a directory; give the path of a fieldguard YAML file"
                                                    : "cannot read the file; check its permissions";
     r.issues.push_back({path, 0, "", why});

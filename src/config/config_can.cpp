@@ -62,7 +62,8 @@ void read_can(YamlReader& r, const YAML::Node& n, const std::string& config_dir,
   if (c.sink == CanSinkKind::Candump) {
     if (c.log_path.empty()) {
       r.issue(n.IsMap() && n["sink"] ? n["sink"] : n, "can.log_path",
-              "sink candump writes a candump log but no log_path is given; name the file, e.g. /var/lib/fieldguard/can.log");
+              "sink candump writes a candump log but no log_path is given; name the file, e.g. "
+              "/var/lib/fieldguard/can.log");
     } else if (std::filesystem::path(c.log_path).is_relative() && !config_dir.empty()) {
       c.log_path = (std::filesystem::path(config_dir) / c.log_path).string();
     }

@@ -22,7 +22,9 @@ void read_geo(YamlReader& r, const YAML::Node& n, GeoConfig& c) {
     return;
   }
   if (auto e = r.choice(n, path, "ellipsoid", {"WGS84", "CGCS2000", "Krasovsky"})) {
-    c.projection.ellipsoid = *e == 0 ? geo::Ellipsoid::Wgs84 : *e == 1 ? geo::Ellipsoid::Cgcs2000 : geo::Ellipsoid::Krasovsky1940;
+    c.projection.ellipsoid = *e == 0   ? geo::Ellipsoid::Wgs84
+                             : *e == 1 ? geo::Ellipsoid::Cgcs2000
+                                       : geo::Ellipsoid::Krasovsky1940;
   }
   if (auto w = r.choice(n, path, "zone_width_deg", {"3", "6"})) {
     c.projection.zone_width = *w == 0 ? geo::ZoneWidth::Three : geo::ZoneWidth::Six;
@@ -30,7 +32,8 @@ void read_geo(YamlReader& r, const YAML::Node& n, GeoConfig& c) {
   r.integer(n, path, "fixed_zone", c.projection.fixed_zone, 0, 120);
   if (auto p = r.choice(n, path, "zone_prefix", {"false", "true"})) c.projection.zone_prefix = *p == 1;
   r.vec3(n, path, "antenna_m", c.antenna_m, -20.0, 20.0, "m, vehicle frame");
-  if (auto f = r.choice(n, path, "ahrs_frame", {"enu", "ned"})) c.ahrs_frame = *f == 0 ? geo::AhrsFrame::Enu : geo::AhrsFrame::Ned;
+  if (auto f = r.choice(n, path, "ahrs_frame", {"enu", "ned"}))
+    c.ahrs_frame = *f == 0 ? geo::AhrsFrame::Enu : geo::AhrsFrame::Ned;
   r.number(n, path, "declination_deg", c.declination_deg, -180.0, 180.0, "degrees");
   r.integer(n, path, "min_gnss_quality", c.min_gnss_quality, 1, 5);
   r.number(n, path, "max_attitude_gap_s", c.max_attitude_gap_s, 0.001, 5.0, "s");

@@ -11,7 +11,8 @@ void read_pipeline(YamlReader& r, const YAML::Node& n, PipelineConfig& c) {
   // The limits are sync::PoolParams' own: a value the loader accepts never makes the pool throw.
   r.integer(n, path, "workers", c.workers, 1, 64);
   r.integer(n, path, "queue_capacity", c.queue_capacity, 1, 4096);
-  if (auto d = r.choice(n, path, "drop", {"oldest", "newest"})) c.drop = *d == 0 ? PipelineDrop::Oldest : PipelineDrop::Newest;
+  if (auto d = r.choice(n, path, "drop", {"oldest", "newest"}))
+    c.drop = *d == 0 ? PipelineDrop::Oldest : PipelineDrop::Newest;
 }
 
 namespace {
@@ -39,9 +40,9 @@ void read_cpus(YamlReader& r, const YAML::Node& n, const std::string& path, cons
 
 void read_realtime(YamlReader& r, const YAML::Node& n, RealtimeConfig& c) {
   const std::string path = "realtime";
-  if (!r.section(n, path,
-                 {"policy", "io_priority", "worker_priority", "io_cpus", "worker_cpus", "lock_memory",
-                  "latency_budget_ms"})) {
+  if (!r.section(
+          n, path,
+          {"policy", "io_priority", "worker_priority", "io_cpus", "worker_cpus", "lock_memory", "latency_budget_ms"})) {
     return;
   }
   if (auto p = r.choice(n, path, "policy", {"other", "fifo", "rr"})) {

@@ -126,8 +126,12 @@ void read_safety(YamlReader& r, const YAML::Node& n, Config& c) {
     if (p.sensor(l.sensor).required && !l.enabled) {
       const std::string key = std::string("sensors.").append(to_string(l.sensor)).append(".required");
       r.issue(node_at(n, key), join_path(path, key.c_str()),
-              std::string("the sensor is required but ").append(l.section).append(".enabled is false; the tractor would "
-                  "never start: enable ").append(l.section).append(" or set required to false"));
+              std::string("the sensor is required but ")
+                  .append(l.section)
+                  .append(".enabled is false; the tractor would "
+                          "never start: enable ")
+                  .append(l.section)
+                  .append(" or set required to false"));
     }
   }
 }

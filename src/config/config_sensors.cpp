@@ -8,7 +8,7 @@ void read_bool(YamlReader& r, const YAML::Node& n, const std::string& path, cons
 }
 
 // Serial link keys shared by gnss and ahrs.
-constexpr std::initializer_list<const char*> kSerialKeys = {"enabled", "device", "baud", "framing",
+constexpr std::initializer_list<const char*> kSerialKeys = {"enabled",           "device",           "baud", "framing",
                                                             "silence_timeout_s", "reopen_interval_s"};
 
 void read_serial(YamlReader& r, const YAML::Node& n, const std::string& path, SerialConfig& c) {
@@ -24,7 +24,8 @@ void read_serial(YamlReader& r, const YAML::Node& n, const std::string& path, Se
     const bool ok = s.size() == 3 && s[0] >= '5' && s[0] <= '8' && (s[1] == 'N' || s[1] == 'E' || s[1] == 'O') &&
                     (s[2] == '1' || s[2] == '2');
     if (!ok) {
-      r.issue(f, path + ".framing", "'" + s + "' is not a framing like 8N1 (data bits 5-8, parity N/E/O, stop bits 1-2)");
+      r.issue(f, path + ".framing",
+              "'" + s + "' is not a framing like 8N1 (data bits 5-8, parity N/E/O, stop bits 1-2)");
     } else {
       c.data_bits = static_cast<unsigned>(s[0] - '0');
       c.parity = s[1];
@@ -34,7 +35,8 @@ void read_serial(YamlReader& r, const YAML::Node& n, const std::string& path, Se
   r.number(n, path, "silence_timeout_s", c.silence_timeout_s, 0.01, 60.0, "s");
   r.number(n, path, "reopen_interval_s", c.reopen_interval_s, 0.01, 60.0, "s");
   if (c.enabled && c.device.empty()) {
-    r.issue(n, path + ".device", "the link is enabled but names no device; give e.g. /dev/ttyUSB0 or a /dev/serial/by-id/ link");
+    r.issue(n, path + ".device",
+            "the link is enabled but names no device; give e.g. /dev/ttyUSB0 or a /dev/serial/by-id/ link");
   }
 }
 
@@ -68,9 +70,11 @@ void read_scan2d(YamlReader& r, const YAML::Node& n, Scan2dConfig& c) {
   r.number(n, path, "backoff_max_s", c.backoff_max_s, 0.05, 600.0, "s");
   read_mounting(r, n["mounting"], "scan2d.mounting", c.mounting);
   if (c.start_step > c.end_step) {
-    r.issue(n["end_step"] ? n["end_step"] : n, "scan2d.end_step", "must not be less than start_step (steps 0..1080, front at 540)");
+    r.issue(n["end_step"] ? n["end_step"] : n, "scan2d.end_step",
+            "must not be less than start_step (steps 0..1080, front at 540)");
   }
-  if (c.enabled && c.host.empty()) r.issue(n, "scan2d.host", "the 2D LiDAR is enabled but has no host; the factory default is 192.168.0.10");
+  if (c.enabled && c.host.empty())
+    r.issue(n, "scan2d.host", "the 2D LiDAR is enabled but has no host; the factory default is 192.168.0.10");
 }
 
 void read_gnss(YamlReader& r, const YAML::Node& n, GnssConfig& c) {
@@ -80,7 +84,8 @@ void read_gnss(YamlReader& r, const YAML::Node& n, GnssConfig& c) {
 }
 
 void read_ahrs(YamlReader& r, const YAML::Node& n, AhrsConfig& c) {
-  if (!r.section(n, "ahrs", {"enabled", "device", "baud", "framing", "silence_timeout_s", "reopen_interval_s", "mounting"})) {
+  if (!r.section(n, "ahrs",
+                 {"enabled", "device", "baud", "framing", "silence_timeout_s", "reopen_interval_s", "mounting"})) {
     return;
   }
   read_serial(r, n, "ahrs", c.serial);

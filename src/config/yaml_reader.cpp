@@ -100,7 +100,8 @@ void YamlReader::number(const YAML::Node& map, const std::string& path, const ch
   const auto v = as_number(map[key], p, unit);
   if (!v) return;
   if (*v < lo || *v > hi) {
-    issue(map[key], p, fmt_num(*v) + " is out of range; use a value from " + fmt_num(lo) + " to " + fmt_num(hi) + " " + unit);
+    issue(map[key], p,
+          fmt_num(*v) + " is out of range; use a value from " + fmt_num(lo) + " to " + fmt_num(hi) + " " + unit);
     return;
   }
   out = *v;
@@ -123,7 +124,8 @@ void YamlReader::integer(const YAML::Node& map, const std::string& path, const c
     return;
   }
   if (n < lo || n > hi) {
-    issue(v, p, std::to_string(n) + " is out of range; use a value from " + std::to_string(lo) + " to " + std::to_string(hi));
+    issue(v, p,
+          std::to_string(n) + " is out of range; use a value from " + std::to_string(lo) + " to " + std::to_string(hi));
     return;
   }
   out = static_cast<int>(n);
@@ -175,8 +177,9 @@ void YamlReader::vec3(const YAML::Node& map, const std::string& path, const char
   const auto p = join_path(path, key);
   const YAML::Node v = map[key];
   if (!v.IsSequence() || v.size() != 3) {
-    issue(v, p, std::string("expected a list of 3 numbers [x, y, z] (") + unit + "), got " +
-                    (v.IsSequence() ? std::to_string(v.size()) + " items" : kind_of(v)));
+    issue(v, p,
+          std::string("expected a list of 3 numbers [x, y, z] (") + unit + "), got " +
+              (v.IsSequence() ? std::to_string(v.size()) + " items" : kind_of(v)));
     return;
   }
   std::array<double, 3> r{};

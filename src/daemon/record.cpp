@@ -11,12 +11,12 @@
 #include <fstream>
 #include <optional>
 
+#include "daemon/source_options.hpp"
+#include "fieldguard/config/config.hpp"
 #include "fieldguard/core/exit_code.hpp"
 #include "fieldguard/daemon/daemon.hpp"
 #include "fieldguard/engine/logging.hpp"
 #include "fieldguard/engine/samples.hpp"
-#include "daemon/source_options.hpp"
-#include "fieldguard/config/config.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/io/pcap_writer.hpp"
 #include "fieldguard/io/scip_source.hpp"
@@ -27,7 +27,6 @@ namespace fieldguard::app {
 namespace {
 
 namespace fs = std::filesystem;
-
 
 }  // namespace
 
@@ -93,7 +92,8 @@ int record(const RecordOptions& opt) {
     const io::ScipSourceOptions o = scip_source_options(cfg.scan2d);
     scip = std::make_unique<io::ScipSource>(io, o, nullptr, [&](const std::string& w) { log->info("scan2d: {}", w); });
     scip->set_tap([&](ByteSpan b, bool to_sensor, Stamp t) {
-      if (scan_log && !scan_log->write(t, to_sensor ? io::Direction::ToSensor : io::Direction::FromSensor, b)) ++write_failures;
+      if (scan_log && !scan_log->write(t, to_sensor ? io::Direction::ToSensor : io::Direction::FromSensor, b))
+        ++write_failures;
       samples.scan2d(b, to_sensor);
     });
     scip->start();
@@ -128,7 +128,8 @@ int record(const RecordOptions& opt) {
   signals.async_wait([&](const boost::system::error_code&, int) { io.stop(); });
   boost::asio::steady_timer timer(io);
   if (duration_s > 0.0) {
-    timer.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration_s)));
+    timer.expires_after(
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration_s)));
     timer.async_wait([&](const boost::system::error_code& e) {
       if (!e) io.stop();
     });
@@ -145,11 +146,12 @@ int record(const RecordOptions& opt) {
   if (gnss_log) gnss_log->flush();
   if (ahrs_log) ahrs_log->flush();
   const auto& c = samples.counts();
-  std::printf("record summary: %s\n  lidar frames      %llu\n  scans             %llu\n  gnss sentences    %llu\n"
-              "  ahrs messages     %llu\n  write failures    %llu\n",
-              dir.c_str(), static_cast<unsigned long long>(c.lidar_frames), static_cast<unsigned long long>(c.scans),
-              static_cast<unsigned long long>(c.gnss), static_cast<unsigned long long>(c.ahrs),
-              static_cast<unsigned long long>(write_failures));
+  std::printf(
+      "record summary: %s\n  lidar frames      %llu\n  scans             %llu\n  gnss sentences    %llu\n"
+      "  ahrs messages     %llu\n  write failures    %llu\n",
+      dir.c_str(), static_cast<unsigned long long>(c.lidar_frames), static_cast<unsigned long long>(c.scans),
+      static_cast<unsigned long long>(c.gnss), static_cast<unsigned long long>(c.ahrs),
+      static_cast<unsigned long long>(write_failures));
   return write_failures == 0 ? kExitOk : kExitFailure;
 }
 

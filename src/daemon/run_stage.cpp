@@ -85,7 +85,8 @@ const safety::Decision& LiveStage::tick(Stamp now, std::uint64_t frames_lost) {
   // Before the first decision the schedule already repeats STOP, starting up; afterwards a change decided
   // between rotations (a timeout) must not wait for a rotation that may never come.
   const output::StopRequest request = CanStage::request_for(*last_);
-  if (sent_ ? !same_request(*sent_, request) : request.command != output::StopCommand::Stop || !request.reasons.starting_up) {
+  if (sent_ ? !same_request(*sent_, request)
+            : request.command != output::StopCommand::Stop || !request.reasons.starting_up) {
     sent_ = request;
     schedule_.stop(request, now);
   }

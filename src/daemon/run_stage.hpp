@@ -22,10 +22,10 @@
 namespace fieldguard::app {
 
 struct LiveStageCounts {
-  std::uint64_t frames = 0;      // rotations decided
+  std::uint64_t frames = 0;  // rotations decided
   std::uint64_t stop_frames = 0;
   std::uint64_t go_frames = 0;
-  std::uint64_t changes = 0;     // monitor events, each logged once
+  std::uint64_t changes = 0;  // monitor events, each logged once
 };
 
 class LiveStage {
@@ -65,7 +65,7 @@ class LiveStage {
   output::safety::Monitor monitor_;
   output::safety::Input input_;
   std::optional<output::safety::Decision> last_;
-  std::optional<output::StopRequest> sent_;  // the stop request the schedule repeats
+  std::optional<output::StopRequest> sent_;        // the stop request the schedule repeats
   std::optional<std::pair<double, Stamp>> speed_;  // m/s, receive time
   LiveStageCounts counts_;
 };

@@ -2,8 +2,8 @@
 
 #include <pthread.h>
 
-#include <boost/asio/post.hpp>
 #include <algorithm>
+#include <boost/asio/post.hpp>
 #include <cstdio>
 #include <optional>
 #include <span>
@@ -144,8 +144,10 @@ void Session::on_tick(std::chrono::nanoseconds late) {
   if (!worker_refusal_logged_) {
     if (std::string refused = pool_.thread_refusal(); !refused.empty()) {
       worker_refusal_logged_ = true;
-      log_->warn("realtime: the perception workers run without what the system refused ({}); detection goes on at "
-                 "normal priority", refused);
+      log_->warn(
+          "realtime: the perception workers run without what the system refused ({}); detection goes on at "
+          "normal priority",
+          refused);
     }
   }
   pass_problems();
@@ -157,8 +159,8 @@ void Session::on_tick(std::chrono::nanoseconds late) {
   stage_.tick(now, lost_);
   // A decision on the clock is progress unless rotations are stuck in the pipeline: then the watchdog
   // starves and systemd restarts a daemon whose workers no longer work.
-  const bool stalled = !submitted_.empty() && static_cast<double>(now.ns - submitted_.front().ns) * 1e-9 >
-                                                   cfg_.safety.max_frame_interval_s;
+  const bool stalled = !submitted_.empty() &&
+                       static_cast<double>(now.ns - submitted_.front().ns) * 1e-9 > cfg_.safety.max_frame_interval_s;
   if (stalled != stalled_) {
     stalled_ = stalled;
     if (stalled) {
@@ -189,7 +191,8 @@ std::string Session::status(Stamp now) const {
     const auto age = health_.age_s(kind_of(s), now);
     if (p.required && (!age || *age > p.timeout_s)) waiting = kind_of(s);
   }
-  std::string line = health_.status_line(now, waiting, stage_.counts().frames, fusion_.stream().counters().partial_rotations);
+  std::string line =
+      health_.status_line(now, waiting, stage_.counts().frames, fusion_.stream().counters().partial_rotations);
   if (const auto& d = stage_.last_decision()) {
     line += d->stop ? " | STOP " + std::string(safety::to_string(d->reason)) : " | GO";
   }
@@ -233,18 +236,20 @@ void Session::print_summary() const {
   if (const sync::Synchronizer* sy = fusion_.synchronizer()) {
     const auto& ac = sy->assembler().counters();
     const auto& fc = fusion_.counts();
-    std::printf("  fused frames      %llu: %llu complete, %llu timed out, %llu overflowed, %llu late rotations dropped\n",
-                u(ac.frames), u(ac.complete), u(ac.timed_out), u(ac.overflowed), u(ac.late_rotations));
-    std::printf("  lacking           %llu lidar3d, %llu scan2d, %llu gnss, %llu ahrs\n", u(ac.missing[0]), u(ac.missing[1]),
-                u(ac.missing[2]), u(ac.missing[3]));
+    std::printf(
+        "  fused frames      %llu: %llu complete, %llu timed out, %llu overflowed, %llu late rotations dropped\n",
+        u(ac.frames), u(ac.complete), u(ac.timed_out), u(ac.overflowed), u(ac.late_rotations));
+    std::printf("  lacking           %llu lidar3d, %llu scan2d, %llu gnss, %llu ahrs\n", u(ac.missing[0]),
+                u(ac.missing[1]), u(ac.missing[2]), u(ac.missing[3]));
     std::printf("  samples           %llu scans, %llu gnss sentences, %llu ahrs messages; errors %llu, %llu, %llu\n",
                 u(fc.scans), u(fc.gnss), u(fc.ahrs), u(fc.scan_errors), u(fc.gnss_errors), u(fc.ahrs_errors));
   }
   const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };
-  std::printf("  latency           median %.3f ms, p99 %.3f ms, max %.3f ms over %llu frames (frame whole to stop "
-              "request); %llu late (over %.1f ms)\n",
-              ms(latency_.quantile_ns(0.5)), ms(latency_.quantile_ns(0.99)), ms(latency_.max_ns()), u(latency_.count()),
-              u(late_), cfg_.realtime.latency_budget_ms);
+  std::printf(
+      "  latency           median %.3f ms, p99 %.3f ms, max %.3f ms over %llu frames (frame whole to stop "
+      "request); %llu late (over %.1f ms)\n",
+      ms(latency_.quantile_ns(0.5)), ms(latency_.quantile_ns(0.99)), ms(latency_.max_ns()), u(latency_.count()),
+      u(late_), cfg_.realtime.latency_budget_ms);
   std::printf("  io loop           longest gap %.3f ms (a due timer waited that long for the io thread)\n",
               ms(io_gap_.max_ns()));
   if (!timed_.empty()) {
@@ -348,8 +353,10 @@ void Session::deliver(const Pool::Result& r) {
   const std::int64_t latency_ns = wall_clock_now().ns - r.input->complete.ns;
   latency_.add(latency_ns);
   if (static_cast<double>(latency_ns) * 1e-6 > cfg_.realtime.latency_budget_ms && late_++ == 0) {
-    log_->warn("frame decided {:.3f} ms after it was whole, over realtime.latency_budget_ms {} (counted; this "
-               "is said once)", static_cast<double>(latency_ns) * 1e-6, cfg_.realtime.latency_budget_ms);
+    log_->warn(
+        "frame decided {:.3f} ms after it was whole, over realtime.latency_budget_ms {} (counted; this "
+        "is said once)",
+        static_cast<double>(latency_ns) * 1e-6, cfg_.realtime.latency_budget_ms);
   }
   if (ready_) notify_.progress(SteadyClock::now());
 }

@@ -3,8 +3,8 @@
 // and its output stage, all on one io_context. A reload replaces the whole session; the CAN sink outlives it.
 // Thread contract: everything here runs on the io thread, but process(), which the pool's workers call.
 
-#include <boost/asio/io_context.hpp>
 #include <atomic>
+#include <boost/asio/io_context.hpp>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "daemon/run_stage.hpp"
-#include "fieldguard/core/latency_stats.hpp"
 #include "daemon/systemd_notify.hpp"
 #include "fieldguard/config/config.hpp"
+#include "fieldguard/core/latency_stats.hpp"
 #include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/engine/logging.hpp"
 #include "fieldguard/io/can_reader.hpp"
@@ -31,7 +31,6 @@ namespace fieldguard::app {
 class Session {
   using Pool = sync::OrderedPool<FrameJob, DetectedFrame>;
   using SteadyClock = std::chrono::steady_clock;
-
 
  public:
   // `ready`: READY=1 was sent (by this process, for any session): the watchdog is fed only from then on.
@@ -113,15 +112,15 @@ class Session {
   // The detection times of the status and the summary: the last 5 s at 10 Hz.
   static constexpr std::size_t kTimedRotations = 50;
   std::deque<perception::StageTimes> timed_;  // Pipeline::process()'s of the last rotations delivered, oldest first
-  float worst_us_ = 0.F;                       // the longest process() of the run
-  std::uint64_t timed_count_ = 0;              // rotations delivered
-  std::uint64_t lost_ = 0;       // rotations dropped, refused or failed
+  float worst_us_ = 0.F;                      // the longest process() of the run
+  std::uint64_t timed_count_ = 0;             // rotations delivered
+  std::uint64_t lost_ = 0;                    // rotations dropped, refused or failed
   std::uint64_t bad_length_ = 0;
   bool heard_all_ = false;
   bool stalled_ = false;
-  LatencyStats latency_;        // per frame: last packet's kernel receive time to its stop request's write
-  LatencyStats io_gap_;         // per tick: how late the output timer ran
-  std::uint64_t late_ = 0;      // frames over realtime.latency_budget_ms
+  LatencyStats latency_;    // per frame: last packet's kernel receive time to its stop request's write
+  LatencyStats io_gap_;     // per tick: how late the output timer ran
+  std::uint64_t late_ = 0;  // frames over realtime.latency_budget_ms
   bool worker_refusal_logged_ = false;
   bool stopped_ = false;
   SteadyClock::time_point last_status_{};

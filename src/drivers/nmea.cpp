@@ -26,7 +26,9 @@ constexpr std::size_t kHdtMinFields = 2;
 constexpr std::size_t kThsMinFields = 2;
 
 // A unit or reference letter ("T", "M", "N", "K"): empty or exactly `expected`.
-bool unit_ok(std::string_view field, char expected) { return field.empty() || (field.size() == 1 && field[0] == expected); }
+bool unit_ok(std::string_view field, char expected) {
+  return field.empty() || (field.size() == 1 && field[0] == expected);
+}
 
 // A heading or course in degrees: empty, or 0..360 (some receivers send 360.0 for north).
 std::optional<double> heading(FieldReader& in, std::string_view field) {

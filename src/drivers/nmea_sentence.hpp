@@ -19,8 +19,8 @@ using nmea::kMaxSentenceLength;
 inline constexpr std::size_t kMaxFields = 24;
 
 struct Frame {
-  std::string_view talker;  // "GP", "GN", ... (empty for a proprietary or odd address)
-  std::string_view type;    // "RMC", "GGA", ...
+  std::string_view talker;                            // "GP", "GN", ... (empty for a proprietary or odd address)
+  std::string_view type;                              // "RMC", "GGA", ...
   std::array<std::string_view, kMaxFields> fields{};  // fields[0] = first field after the address
   std::size_t field_count = 0;
 
@@ -36,10 +36,10 @@ struct Frame {
 template <typename T>
 using Field = Expected<std::optional<T>, Error>;
 
-[[nodiscard]] Field<double> decimal(std::string_view f);                 // [-+]digits[.digits]
-[[nodiscard]] Field<int> integer(std::string_view f);                    // digits
-[[nodiscard]] Field<char> letter(std::string_view f);                    // one upper-case letter
-[[nodiscard]] Field<double> time_of_day(std::string_view f);             // hhmmss[.s...] -> seconds of the day
+[[nodiscard]] Field<double> decimal(std::string_view f);      // [-+]digits[.digits]
+[[nodiscard]] Field<int> integer(std::string_view f);         // digits
+[[nodiscard]] Field<char> letter(std::string_view f);         // one upper-case letter
+[[nodiscard]] Field<double> time_of_day(std::string_view f);  // hhmmss[.s...] -> seconds of the day
 [[nodiscard]] Field<double> latitude(std::string_view value, std::string_view hemisphere);   // ddmm.m, N/S
 [[nodiscard]] Field<double> longitude(std::string_view value, std::string_view hemisphere);  // dddmm.m, E/W
 

@@ -149,14 +149,16 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarP
   if (!header) return header;
   if (!ready()) return Unexpected{DecodeError::NoCalibration};
 
-  const ReturnMode mode = return_mode_ ? *return_mode_ : (header->dual_layout ? ReturnMode::Dual : ReturnMode::Strongest);
+  const ReturnMode mode =
+      return_mode_ ? *return_mode_ : (header->dual_layout ? ReturnMode::Dual : ReturnMode::Strongest);
   const bool dual = mode == ReturnMode::Dual;
-  const std::size_t step = dual ? 2 : 1;              // blocks per firing group
+  const std::size_t step = dual ? 2 : 1;  // blocks per firing group
   const std::size_t groups = kBlocksPerPacket / step;
 
   // Azimuth of each firing group and its step to the next: the measured step when it is plausible, else the
   // previous plausible one, else the nominal step at the DIFOP's rpm (rs_driver's BLOCK_AZ_DURATION).
-  const double nominal = static_cast<double>(kFullTurnCdeg) * (static_cast<double>(rpm_) / 60.0) * kBlockDurationUs * 1e-6;
+  const double nominal =
+      static_cast<double>(kFullTurnCdeg) * (static_cast<double>(rpm_) / 60.0) * kBlockDurationUs * 1e-6;
   std::array<double, kBlocksPerPacket> az{};
   std::array<double, kBlocksPerPacket> delta{};
   double fallback = nominal;

@@ -13,8 +13,7 @@ std::uint64_t StreamCounters::difop_rejected() const {
   return std::accumulate(difop_errors.begin(), difop_errors.end(), std::uint64_t{0});
 }
 
-Stream::Stream(StreamOptions options)
-    : decoder_(std::move(options.decoder)), assembler_(options.rotation_cut_deg) {}
+Stream::Stream(StreamOptions options) : decoder_(std::move(options.decoder)), assembler_(options.rotation_cut_deg) {}
 
 void Stream::count_frames(const std::vector<LidarFrame>& frames, std::size_t from) {
   for (std::size_t i = from; i < frames.size(); ++i) {

@@ -220,7 +220,8 @@ bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sens
 
 void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time,
                                std::vector<LidarFrame>& done, AzimuthRange azimuths) {
-  if (!commit_within_frame(count, packet_sensor_time, azimuths)) commit(count, packet_sensor_time, packet_host_time, done);
+  if (!commit_within_frame(count, packet_sensor_time, azimuths))
+    commit(count, packet_sensor_time, packet_host_time, done);
 }
 
 void RotationAssembler::finish(std::vector<LidarFrame>& done) {

@@ -14,10 +14,22 @@ struct CommandForm {
   std::size_t digits;  // fixed-width decimal parameters after the name in a command line / echo
 };
 constexpr std::array<CommandForm, 16> kForms = {{
-    {Command::Scip20, "SCIP2.0", 0}, {Command::VV, "VV", 0}, {Command::PP, "PP", 0}, {Command::II, "II", 0},
-    {Command::BM, "BM", 0},          {Command::QT, "QT", 0}, {Command::RS, "RS", 0}, {Command::RT, "RT", 0},
-    {Command::RB, "RB", 0},          {Command::TM, "TM", 1}, {Command::MD, "MD", 13}, {Command::ME, "ME", 13},
-    {Command::MS, "MS", 13},         {Command::GD, "GD", 10}, {Command::GE, "GE", 10}, {Command::GS, "GS", 10},
+    {Command::Scip20, "SCIP2.0", 0},
+    {Command::VV, "VV", 0},
+    {Command::PP, "PP", 0},
+    {Command::II, "II", 0},
+    {Command::BM, "BM", 0},
+    {Command::QT, "QT", 0},
+    {Command::RS, "RS", 0},
+    {Command::RT, "RT", 0},
+    {Command::RB, "RB", 0},
+    {Command::TM, "TM", 1},
+    {Command::MD, "MD", 13},
+    {Command::ME, "ME", 13},
+    {Command::MS, "MS", 13},
+    {Command::GD, "GD", 10},
+    {Command::GE, "GE", 10},
+    {Command::GS, "GS", 10},
 }};
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }

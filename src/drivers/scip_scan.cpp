@@ -120,7 +120,7 @@ void scan_to_points(const Scan& scan, const Geometry& g, std::vector<Point2>& ou
 std::uint64_t TimestampUnwrapper::unwrap(std::uint32_t raw_ms) {
   constexpr std::uint32_t kRange = 1U << 24;
   raw_ms &= kRange - 1;
-  if (last_ && raw_ms < *last_ && *last_ - raw_ms > kRange / 2) ++wraps_;
+  if (last_ && raw_ms<*last_&& * last_ - raw_ms> kRange / 2) ++wraps_;
   last_ = raw_ms;
   return wraps_ * kRange + raw_ms;
 }

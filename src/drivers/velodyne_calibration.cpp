@@ -16,11 +16,10 @@ namespace fieldguard::velodyne {
 namespace {
 
 // protocols.md §1.5: HDL-32E vertical angles by slot (= laser id, firing order), degrees.
-constexpr std::array<double, 32> kHdl32eVertDeg = {
-    -30.67, -9.33, -29.33, -8.00, -28.00, -6.67, -26.67, -5.33,  //
-    -25.33, -4.00, -24.00, -2.67, -22.67, -1.33, -21.33, 0.00,   //
-    -20.00, 1.33,  -18.67, 2.67,  -17.33, 4.00,  -16.00, 5.33,   //
-    -14.67, 6.67,  -13.33, 8.00,  -12.00, 9.33,  -10.67, 10.67};
+constexpr std::array<double, 32> kHdl32eVertDeg = {-30.67, -9.33, -29.33, -8.00, -28.00, -6.67, -26.67, -5.33,  //
+                                                   -25.33, -4.00, -24.00, -2.67, -22.67, -1.33, -21.33, 0.00,   //
+                                                   -20.00, 1.33,  -18.67, 2.67,  -17.33, 4.00,  -16.00, 5.33,   //
+                                                   -14.67, 6.67,  -13.33, 8.00,  -12.00, 9.33,  -10.67, 10.67};
 
 // protocols.md §1.10: VLP-16 vertical angles by laser id, degrees.
 constexpr std::array<double, 16> kVlp16VertDeg = {-15, 1, -13, 3, -11, 5, -9, 7, -7, 9, -5, 11, -3, 13, -1, 15};

@@ -10,13 +10,12 @@
 // enabled_ list), and only ids below it are read.
 
 #include <algorithm>
+#include <boost/property_tree/ptree.hpp>
+#include <boost/property_tree/xml_parser.hpp>
 #include <cmath>
 #include <optional>
 #include <sstream>
 #include <string>
-
-#include <boost/property_tree/ptree.hpp>
-#include <boost/property_tree/xml_parser.hpp>
 
 #include "drivers/velodyne_calibration_detail.hpp"
 #include "fieldguard/drivers/velodyne_calibration.hpp"
@@ -154,9 +153,9 @@ Expected<Calibration, std::string> parse_db(std::string_view xml_text) {
   if (!db) db = tree.get_child_optional("DB");
   const auto points = db ? db->get_child_optional("points_") : boost::none;
   if (!points) {
-    return Unexpected{std::string(
-        "not a db.xml: no DB/points_ element (expected a VeloView calibration: "
-        "boost_serialization/DB/points_/item/px/...)")};
+    return Unexpected{
+        std::string("not a db.xml: no DB/points_ element (expected a VeloView calibration: "
+                    "boost_serialization/DB/points_/item/px/...)")};
   }
   Issues issues;
 
@@ -164,7 +163,8 @@ Expected<Calibration, std::string> parse_db(std::string_view xml_text) {
   if (const auto lsb = db->get_child_optional("distLSB_")) {
     const auto v = detail::parse_number(lsb->data());
     if (!v || *v <= 0.0 || *v > kMaxLsbCm) {
-      issues.add("distLSB_ " + detail::quoted(lsb->data()) + " is not a distance in cm between 0 and 1 (Velodyne: 0.2)");
+      issues.add("distLSB_ " + detail::quoted(lsb->data()) +
+                 " is not a distance in cm between 0 and 1 (Velodyne: 0.2)");
     } else {
       lsb_cm = *v;
     }

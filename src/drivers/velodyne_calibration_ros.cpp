@@ -9,13 +9,13 @@
 // (32db.yaml lists 64 with num_lasers: 32) and each is stored at its laser_id. Unlike the ROS driver,
 // fields we do not use may be absent; a field that is present must be a number.
 
+#include <yaml-cpp/yaml.h>
+
 #include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
 #include <string>
-
-#include <yaml-cpp/yaml.h>
 
 #include "drivers/velodyne_calibration_detail.hpp"
 #include "fieldguard/drivers/velodyne_calibration.hpp"
@@ -31,12 +31,11 @@ constexpr double kMaxResolutionM = 0.01;  // Velodyne sensors use 2 mm (4 mm on 
 
 // Fields that must be there.
 constexpr std::array<std::string_view, 4> kRequired = {"rot_correction", "vert_correction", "dist_correction",
-                                                      "vert_offset_correction"};
+                                                       "vert_offset_correction"};
 // Fields that may be absent: the first three then read as 0, the rest are not used. Checked when present.
-constexpr std::array<std::string_view, 7> kOptional = {"horiz_offset_correction", "dist_correction_x",
-                                                      "dist_correction_y",       "focal_distance",
-                                                      "focal_slope",             "min_intensity",
-                                                      "max_intensity"};
+constexpr std::array<std::string_view, 7> kOptional = {
+    "horiz_offset_correction", "dist_correction_x", "dist_correction_y", "focal_distance", "focal_slope",
+    "min_intensity",           "max_intensity"};
 
 [[nodiscard]] std::string line_of(const YAML::Node& node) {
   const YAML::Mark m = node.Mark();
@@ -61,7 +60,8 @@ std::optional<double> number_field(const YAML::Node& entry, std::string_view key
     return std::nullopt;
   }
   auto v = detail::parse_number(node.Scalar());
-  if (!v) issues.add(where + ": " + std::string(key) + " is not a number: " + detail::quoted(node.Scalar()) + line_of(node));
+  if (!v)
+    issues.add(where + ": " + std::string(key) + " is not a number: " + detail::quoted(node.Scalar()) + line_of(node));
   return v;
 }
 
@@ -115,9 +115,9 @@ void read_laser(const YAML::Node& entry, std::size_t index, detail::LaserTable& 
 Expected<Calibration, std::string> parse_ros(std::string_view yaml_text) {
   const YAML::Node root = YAML::Load(std::string(yaml_text));
   if (!root.IsMap()) {
-    return Unexpected{std::string(
-        "not a ROS calibration YAML: the top level must be a map with num_lasers and lasers (like "
-        "velodyne_pointcloud/params/32db.yaml)")};
+    return Unexpected{
+        std::string("not a ROS calibration YAML: the top level must be a map with num_lasers and lasers (like "
+                    "velodyne_pointcloud/params/32db.yaml)")};
   }
   Issues issues;
 

@@ -22,16 +22,16 @@ namespace fieldguard::velodyne {
 
 namespace {
 
-using kernels::AzimuthEntry;
 using kernels::azimuth_ring_word;
 using kernels::azimuth_table;
+using kernels::AzimuthEntry;
 using kernels::load4;
 using kernels::load_le16_unchecked;
 using kernels::load_le32_unchecked;
 using kernels::put_point_at;
-using kernels::round_cdeg_lround;
 using kernels::return_type_word;
 using kernels::ring_word;
+using kernels::round_cdeg_lround;
 using kernels::transpose4;
 using kernels::Vec4f;
 using kernels::Vec4i;
@@ -54,11 +54,11 @@ constexpr int kMaxGroupStepCdeg = 500;
 
 // Firing layout of one model (protocols.md §1.7, §1.10).
 struct Layout {
-  std::size_t lasers;      // lasers per firing sequence
-  std::size_t sequences;   // firing sequences per block
-  float block_us;          // duration of one block = time between two firing groups
-  float sequence_us;       // duration of one firing sequence
-  float firing_us;         // time between two lasers of a sequence
+  std::size_t lasers;     // lasers per firing sequence
+  std::size_t sequences;  // firing sequences per block
+  float block_us;         // duration of one block = time between two firing groups
+  float sequence_us;      // duration of one firing sequence
+  float firing_us;        // time between two lasers of a sequence
 };
 constexpr Layout kHdl32Layout{32, 1, 46.08F, 46.08F, 1.152F};
 constexpr Layout kVlp16Layout{16, 2, 110.592F, 55.296F, 2.304F};
@@ -179,17 +179,18 @@ Decoder::Decoder(const Calibration& calibration, const DecoderOptions& options)
   }
   if (calibration_.ring_of_laser.size() != calibration_.lasers.size()) assign_rings(calibration_);
   resolution_m_ = static_cast<float>(calibration_.distance_resolution_m);
-  (void)azimuth_table();  // built once per process, here rather than on the first packet
+  (void)azimuth_table();                         // built once per process, here rather than on the first packet
   if (options_.model == Model::Unknown) return;  // decode() refuses every packet: NoModel
 
   const Layout& lay = layout_of(options_.model);
   block_us_ = lay.block_us;
   // Summed in the same order as the point times (group_time_s_, below), so that the marked firing is exactly 0.
-  const float in_block_last = static_cast<float>(lay.sequences - 1) * lay.sequence_us +
-                              static_cast<float>(lay.lasers - 1) * lay.firing_us;
+  const float in_block_last =
+      static_cast<float>(lay.sequences - 1) * lay.sequence_us + static_cast<float>(lay.lasers - 1) * lay.firing_us;
   last_firing_single_us_ = static_cast<float>(kBlocksPerPacket - 1) * lay.block_us + in_block_last;
   // Dual return: the packet holds half as many firings (block pairs); the division is exact (12 blocks).
-  last_firing_dual_us_ = static_cast<float>(kBlocksPerPacket / 2 - 1) * lay.block_us + in_block_last;  // NOLINT(bugprone-integer-division)
+  last_firing_dual_us_ =
+      static_cast<float>(kBlocksPerPacket / 2 - 1) * lay.block_us + in_block_last;  // NOLINT(bugprone-integer-division)
 
   constexpr double kRadPerDeg = std::numbers::pi / 180.0;
   for (std::size_t slot = 0; slot < kSlotsPerBlock; ++slot) {
@@ -452,7 +453,7 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
     }
     // Wrap::None: the packet's azimuth bounds (bounds_of()) lie inside [0, 35999], so every w is already in
     // [0, 36000) and rounds to at most 35999: the wraps above and below would subtract 0.
-    const Vec4i i = __builtin_convertvector(w, Vec4i);  // w >= 0: truncation is floor
+    const Vec4i i = __builtin_convertvector(w, Vec4i);      // w >= 0: truncation is floor
     const Vec4f f = w - __builtin_convertvector(i, Vec4f);  // exact
     // kernels::round_cdeg() in 32-bit lanes, then the azimuth's half of azimuth_ring_word().
     Vec4i r = i - (f >= splat(0.5F));
@@ -555,13 +556,12 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
         // equal) is emitted once, as StrongestAndLast.
         const Returns4 r1 = returns4(block0 + kBlockSize, s, an);
         const Vec4i same = r0.echo == r1.echo;
-        const Vec4i type0 =
-            (same & static_cast<std::int32_t>(return_type_word(ReturnType::StrongestAndLast))) |
-            (~same & static_cast<std::int32_t>(return_type_word(ReturnType::Last)));
+        const Vec4i type0 = (same & static_cast<std::int32_t>(return_type_word(ReturnType::StrongestAndLast))) |
+                            (~same & static_cast<std::int32_t>(return_type_word(ReturnType::Last)));
         const Vec4i keep1 = r1.ok & ~same;
         const Rows w0 = rows_of(r0, time, an.azimuth_ring, type0);
-        const Rows w1 =
-            rows_of(r1, time, an.azimuth_ring, splat_i(static_cast<std::int32_t>(return_type_word(ReturnType::Strongest))));
+        const Rows w1 = rows_of(r1, time, an.azimuth_ring,
+                                splat_i(static_cast<std::int32_t>(return_type_word(ReturnType::Strongest))));
         put(w0.a0, w0.b0, r0.ok[0]);
         put(w1.a0, w1.b0, keep1[0]);
         put(w0.a1, w0.b1, r0.ok[1]);
@@ -576,9 +576,8 @@ std::size_t Decoder::decode_points(const std::uint8_t* bytes, const PacketHeader
   return static_cast<std::size_t>(out - first_free) / sizeof(LidarPoint);
 }
 
-std::size_t Decoder::decode_checked(const std::uint8_t* bytes, const PacketHeader& header,
-                                    const PacketAzimuths& groups, LidarPoint* room,
-                                    std::optional<double> time_offset_s) const {
+std::size_t Decoder::decode_checked(const std::uint8_t* bytes, const PacketHeader& header, const PacketAzimuths& groups,
+                                    LidarPoint* room, std::optional<double> time_offset_s) const {
   const float* const times = groups.dual_ ? group_time_s_[1].data() : group_time_s_[0].data();
   const auto run = [&]<bool kDual, Wrap kWrap>() {
     if (time_offset_s) return decode_points<kDual, kWrap, true>(bytes, header, groups, times, *time_offset_s, room);
@@ -604,8 +603,8 @@ Expected<PacketHeader, DecodeError> Decoder::decode(ByteSpan payload, std::vecto
   // packet after packet to one vector does not reallocate per packet.
   const std::size_t base = out.size();
   out.resize(base + kMaxPointsPerPacket);
-  out.resize(base + decode_checked(payload.data(), *header, azimuths(payload, *header), out.data() + base,
-                                   std::nullopt));
+  out.resize(base +
+             decode_checked(payload.data(), *header, azimuths(payload, *header), out.data() + base, std::nullopt));
   return header;
 }
 

@@ -117,8 +117,8 @@ static_assert(offsetof(LidarPoint, x) == 0 && offsetof(LidarPoint, y) == 4 && of
               offsetof(LidarPoint, intensity) == 12 && offsetof(LidarPoint, time_s) == 16 &&
               offsetof(LidarPoint, range_m) == 20 && offsetof(LidarPoint, azimuth_cdeg) == 24 &&
               offsetof(LidarPoint, ring) == 26 && offsetof(LidarPoint, return_type) == 28 &&
-              offsetof(LidarPoint, source) == 29 && offsetof(LidarPoint, reserved1) == 30 &&
-              sizeof(LidarPoint) == 32 && std::is_trivially_copyable_v<LidarPoint>);
+              offsetof(LidarPoint, source) == 29 && offsetof(LidarPoint, reserved1) == 30 && sizeof(LidarPoint) == 32 &&
+              std::is_trivially_copyable_v<LidarPoint>);
 
 constexpr std::uint32_t azimuth_ring_word(std::uint16_t azimuth_cdeg, std::uint16_t ring) {
   if constexpr (std::endian::native == std::endian::little) return azimuth_cdeg | (std::uint32_t{ring} << 16);

@@ -45,8 +45,9 @@ const char* product_name(std::uint8_t b) {
   }
 }
 
-bool near(double value, double nominal) { return value > nominal * (1.0 - kSpacingTolerance) &&
-                                                 value < nominal * (1.0 + kSpacingTolerance); }
+bool near(double value, double nominal) {
+  return value > nominal * (1.0 - kSpacingTolerance) && value < nominal * (1.0 + kSpacingTolerance);
+}
 
 bool is_dual(const PacketHeader& h) { return h.return_mode == ReturnMode::Dual || h.dual_layout; }
 
@@ -84,8 +85,9 @@ void ModelDetector::observe(const PacketHeader& header) {
                     "VLP-16 firmware reports: VLP-16",
                     median, mode);
     } else {
-      std::snprintf(text, sizeof text, "spacing %.0f us (%s) is a VLP-16's (1327.1 us), product byte 0x%02X (%s): VLP-16",
-                    median, mode, header.product_byte, product_name(header.product_byte));
+      std::snprintf(text, sizeof text,
+                    "spacing %.0f us (%s) is a VLP-16's (1327.1 us), product byte 0x%02X (%s): VLP-16", median, mode,
+                    header.product_byte, product_name(header.product_byte));
     }
     verdict = Model::VLP16;
   } else if (near(median, kHdl32SpacingUs)) {
@@ -95,8 +97,9 @@ void ModelDetector::observe(const PacketHeader& header) {
                     "configure the model",
                     median, mode, header.product_byte, product_name(header.product_byte));
     } else {
-      std::snprintf(text, sizeof text, "spacing %.0f us (%s) is an HDL-32E's (553.0 us), product byte 0x%02X (%s): HDL-32E",
-                    median, mode, header.product_byte, product_name(header.product_byte));
+      std::snprintf(text, sizeof text,
+                    "spacing %.0f us (%s) is an HDL-32E's (553.0 us), product byte 0x%02X (%s): HDL-32E", median, mode,
+                    header.product_byte, product_name(header.product_byte));
       verdict = Model::HDL32E;
     }
   } else {

@@ -8,7 +8,7 @@
 namespace fieldguard::velodyne {
 namespace {
 
-constexpr std::size_t kImuOffset = 14;       // gyro k at 14 + 8k, temperature 16 + 8k, accel X 18 + 8k, Y 20 + 8k
+constexpr std::size_t kImuOffset = 14;  // gyro k at 14 + 8k, temperature 16 + 8k, accel X 18 + 8k, Y 20 + 8k
 constexpr std::size_t kImuStride = 8;
 constexpr std::size_t kTimestampOffset = 198;
 constexpr std::size_t kPpsOffset = 202;

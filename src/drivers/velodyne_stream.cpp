@@ -5,7 +5,9 @@
 
 namespace fieldguard::velodyne {
 
-std::uint64_t StreamCounters::rejected() const { return std::accumulate(errors.begin(), errors.end(), std::uint64_t{0}); }
+std::uint64_t StreamCounters::rejected() const {
+  return std::accumulate(errors.begin(), errors.end(), std::uint64_t{0});
+}
 
 Stream::Stream(StreamOptions options) : options_(std::move(options)), assembler_(options_.rotation_cut_deg) {
   if (options_.calibration && options_.model == Model::Unknown) options_.model = options_.calibration->model;

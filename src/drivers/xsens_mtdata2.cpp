@@ -1,8 +1,8 @@
 // MTData2 payload decoding (protocols.md §5.3).
 
-#include <bit>
-
 #include "fieldguard/drivers/xsens_mtdata2.hpp"
+
+#include <bit>
 
 namespace fieldguard::xsens {
 namespace {

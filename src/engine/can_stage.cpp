@@ -20,9 +20,7 @@ CanStage::CanStage(const Config& cfg, output::CanSink& sink)
 
 void CanStage::start(Stamp t) { schedule_.tick(t, heartbeat(0)); }
 
-void CanStage::sensor_data(safety::Sensor s, Stamp t) {
-  input_.sensors[static_cast<std::size_t>(s)].last_data = t;
-}
+void CanStage::sensor_data(safety::Sensor s, Stamp t) { input_.sensors[static_cast<std::size_t>(s)].last_data = t; }
 
 void CanStage::sensor_problem(safety::Sensor s, safety::Problem p) {
   auto& slot = input_.sensors[static_cast<std::size_t>(s)].problem;
@@ -49,8 +47,8 @@ output::Heartbeat CanStage::heartbeat(std::uint64_t frames_lost) const {
   return heartbeat_for(cfg_.safety, last_, frames_lost);
 }
 
-output::Heartbeat CanStage::heartbeat_for(const safety::Params& safety,
-                                          const std::optional<safety::Decision>& last, std::uint64_t frames_lost) {
+output::Heartbeat CanStage::heartbeat_for(const safety::Params& safety, const std::optional<safety::Decision>& last,
+                                          std::uint64_t frames_lost) {
   auto health = [&](safety::Sensor s) {
     if (!safety.sensor(s).required) return output::SensorHealth::NotRequired;
     if (!last) return output::SensorHealth::Unknown;

@@ -8,11 +8,11 @@
 #include <utility>
 #include <variant>
 
-#include "fieldguard/engine/samples.hpp"
 #include "fieldguard/drivers/nmea_stream.hpp"
 #include "fieldguard/drivers/scip_session.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/drivers/xsens_stream.hpp"
+#include "fieldguard/engine/samples.hpp"
 #include "fieldguard/sync/synchronizer.hpp"
 
 namespace fieldguard::app {

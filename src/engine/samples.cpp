@@ -58,7 +58,8 @@ velodyne::StreamOptions velodyne_stream_options(const LidarConfig& c) {
 }
 
 struct SampleDecoder::Impl {
-  Impl(const Config& c, std::ostream* o) : config(c), out(o), stream(velodyne_stream_options(c.lidar)), session(scip_client_config(c.scan2d)) {}
+  Impl(const Config& c, std::ostream* o)
+      : config(c), out(o), stream(velodyne_stream_options(c.lidar)), session(scip_client_config(c.scan2d)) {}
 
   Config config;
   std::ostream* out;
@@ -80,9 +81,9 @@ struct SampleDecoder::Impl {
       Digest d;
       for (const auto& p : f.points) d.add(&p, sizeof p);
       ++counts.lidar_frames;
-      line("{\"sensor\":\"lidar\",\"frame\":" + std::to_string(f.index) + ",\"stamp_ns\":" + std::to_string(f.host_stamp.ns) +
-           ",\"partial\":" + (f.partial ? "true" : "false") + ",\"points\":" + std::to_string(f.points.size()) +
-           ",\"digest\":\"" + d.hex() + "\"}");
+      line("{\"sensor\":\"lidar\",\"frame\":" + std::to_string(f.index) +
+           ",\"stamp_ns\":" + std::to_string(f.host_stamp.ns) + ",\"partial\":" + (f.partial ? "true" : "false") +
+           ",\"points\":" + std::to_string(f.points.size()) + ",\"digest\":\"" + d.hex() + "\"}");
       stream.recycle(std::move(f));
     }
     frames.clear();
@@ -93,13 +94,13 @@ struct SampleDecoder::Impl {
       ++counts.gnss;
       std::string l = "{\"sensor\":\"gnss\"";
       if (const auto* g = std::get_if<nmea::Gga>(&s)) {
-        l += ",\"type\":\"" + g->talker + "GGA\",\"time\":" + opt(g->utc_seconds_of_day) + ",\"lat_deg\":" + opt(g->lat_deg) +
-             ",\"lon_deg\":" + opt(g->lon_deg) + ",\"alt_m\":" + opt(g->alt_m) +
+        l += ",\"type\":\"" + g->talker + "GGA\",\"time\":" + opt(g->utc_seconds_of_day) +
+             ",\"lat_deg\":" + opt(g->lat_deg) + ",\"lon_deg\":" + opt(g->lon_deg) + ",\"alt_m\":" + opt(g->alt_m) +
              ",\"quality\":" + (g->quality ? std::to_string(*g->quality) : "null");
       } else if (const auto* r = std::get_if<nmea::Rmc>(&s)) {
-        l += ",\"type\":\"" + r->talker + "RMC\",\"time\":" + opt(r->utc_seconds_of_day) + ",\"valid\":" +
-             (r->valid ? "true" : "false") + ",\"lat_deg\":" + opt(r->lat_deg) + ",\"lon_deg\":" + opt(r->lon_deg) +
-             ",\"speed_mps\":" + opt(r->speed_mps);
+        l += ",\"type\":\"" + r->talker + "RMC\",\"time\":" + opt(r->utc_seconds_of_day) +
+             ",\"valid\":" + (r->valid ? "true" : "false") + ",\"lat_deg\":" + opt(r->lat_deg) +
+             ",\"lon_deg\":" + opt(r->lon_deg) + ",\"speed_mps\":" + opt(r->speed_mps);
       } else {
         l += ",\"type\":\"other\",\"index\":" + std::to_string(s.index());
       }
@@ -113,9 +114,10 @@ struct SampleDecoder::Impl {
       const auto* m = std::get_if<xsens::MtData2>(&it);
       if (m == nullptr) continue;
       ++counts.ahrs;
-      std::string l = "{\"sensor\":\"ahrs\",\"packet_counter\":" +
-                      (m->packet_counter ? std::to_string(*m->packet_counter) : std::string("null")) +
-                      ",\"sample_time_fine\":" + (m->sample_time_fine ? std::to_string(*m->sample_time_fine) : std::string("null"));
+      std::string l =
+          "{\"sensor\":\"ahrs\",\"packet_counter\":" +
+          (m->packet_counter ? std::to_string(*m->packet_counter) : std::string("null")) +
+          ",\"sample_time_fine\":" + (m->sample_time_fine ? std::to_string(*m->sample_time_fine) : std::string("null"));
       if (m->euler_deg) {
         l += ",\"euler_deg\":[" + num(m->euler_deg->x) + "," + num(m->euler_deg->y) + "," + num(m->euler_deg->z) + "]";
       }
@@ -154,9 +156,9 @@ void SampleDecoder::scan2d(ByteSpan bytes, bool to_sensor) {
     d.add(s.ranges_mm.data(), s.ranges_mm.size() * sizeof(s.ranges_mm[0]));
     d.add(s.intensities.data(), s.intensities.size() * sizeof(s.intensities[0]));
     ++impl_->counts.scans;
-    impl_->line("{\"sensor\":\"scan2d\",\"timestamp_ms\":" + std::to_string(s.timestamp_ms) + ",\"first_step\":" +
-                std::to_string(s.first_step) + ",\"values\":" + std::to_string(s.ranges_mm.size()) + ",\"digest\":\"" +
-                d.hex() + "\"}");
+    impl_->line("{\"sensor\":\"scan2d\",\"timestamp_ms\":" + std::to_string(s.timestamp_ms) +
+                ",\"first_step\":" + std::to_string(s.first_step) +
+                ",\"values\":" + std::to_string(s.ranges_mm.size()) + ",\"digest\":\"" + d.hex() + "\"}");
   }
 }
 

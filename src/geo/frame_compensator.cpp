@@ -226,8 +226,8 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
       q = at->q;
     } else {
       // atts is in time order (the track refused anything else); the nearest sample is at the bracket.
-      const auto it = std::lower_bound(atts.begin(), atts.end(), f.t,
-                                       [](const AttSample& s, Stamp t) { return s.t < t; });
+      const auto it =
+          std::lower_bound(atts.begin(), atts.end(), f.t, [](const AttSample& s, Stamp t) { return s.t < t; });
       std::int64_t best = std::numeric_limits<std::int64_t>::max();
       const AttSample* nearest = nullptr;
       if (it != atts.end()) {

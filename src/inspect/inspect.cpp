@@ -2,6 +2,8 @@
 // as one JSON line on stdout; a summary (counts by kind and by rejection reason) on stderr.
 // The formats themselves live in inspect_<format>.cpp; see inspect_format.hpp for how to add one.
 
+#include "fieldguard/inspect/inspect.hpp"
+
 #include <sys/types.h>
 
 #include <algorithm>
@@ -15,7 +17,6 @@
 #include <vector>
 
 #include "fieldguard/core/exit_code.hpp"
-#include "fieldguard/inspect/inspect.hpp"
 #include "inspect/inspect_format.hpp"
 
 namespace fieldguard::app {
@@ -24,7 +25,6 @@ namespace {
 using inspect::Capture;
 using inspect::Output;
 using inspect::Summary;
-
 
 using InspectFn = void (*)(Capture&, Output&, Summary&);
 using GuessFn = bool (*)(ByteSpan);

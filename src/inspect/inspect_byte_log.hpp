@@ -10,9 +10,9 @@
 #include <optional>
 #include <string>
 
-#include "inspect/inspect_format.hpp"
 #include "fieldguard/core/bytes.hpp"
 #include "fieldguard/core/time.hpp"
+#include "inspect/inspect_format.hpp"
 
 namespace fieldguard::app::inspect {
 

@@ -13,9 +13,9 @@
 #include <string_view>
 #include <vector>
 
+#include "fieldguard/core/expected.hpp"
 #include "inspect/inspect_format.hpp"
 #include "inspect/json_line.hpp"
-#include "fieldguard/core/expected.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {

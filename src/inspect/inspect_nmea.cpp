@@ -8,10 +8,10 @@
 #include <string>
 #include <variant>
 
+#include "fieldguard/drivers/nmea_stream.hpp"
 #include "inspect/inspect_byte_log.hpp"
 #include "inspect/inspect_format.hpp"
 #include "inspect/json_line.hpp"
-#include "fieldguard/drivers/nmea_stream.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {
@@ -38,9 +38,7 @@ std::string time_of_day(double seconds) {
   return buf.data();
 }
 
-std::string type_name(const nmea::Sentence& s) {
-  return nmea::talker_of(s) + std::string(nmea::type_of(s));
-}
+std::string type_name(const nmea::Sentence& s) { return nmea::talker_of(s) + std::string(nmea::type_of(s)); }
 
 void add_time(JsonLine& j, const std::optional<double>& sod) {
   if (sod) {
@@ -102,12 +100,12 @@ bool looks_like_nmea(ByteSpan head) {
   if (starts_with_byte_log(head)) {
     // What `fieldguard record` saves of the serial line; the source line names it ("gnss /dev/ttyUSB0 ...").
     const std::string source = byte_log_source(head);
-    return source.find("gnss") != std::string::npos || source.find("nmea") != std::string::npos || source.find("gps") != std::string::npos;
+    return source.find("gnss") != std::string::npos || source.find("nmea") != std::string::npos ||
+           source.find("gps") != std::string::npos;
   }
   // Text starting with a sentence or a comment line (gpsd logs), after blank space.
-  const auto first = std::find_if(head.begin(), head.end(), [](std::uint8_t b) {
-    return b != ' ' && b != '\t' && b != '\r' && b != '\n';
-  });
+  const auto first = std::find_if(head.begin(), head.end(),
+                                  [](std::uint8_t b) { return b != ' ' && b != '\t' && b != '\r' && b != '\n'; });
   if (first != head.end() && (*first == '$' || *first == '#')) return true;
   // Or text (a capture that starts mid-sentence, after a BOM, ...) with several lines that start like a sentence.
   std::size_t printable = 0;

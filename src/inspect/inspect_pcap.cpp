@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "inspect/inspect_format.hpp"
 #include "fieldguard/drivers/robosense.hpp"
 #include "fieldguard/drivers/velodyne_types.hpp"
 #include "fieldguard/io/udp_frame.hpp"
+#include "inspect/inspect_format.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {

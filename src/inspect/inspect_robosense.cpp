@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "fieldguard/drivers/robosense_stream.hpp"
 #include "inspect/inspect_format.hpp"
 #include "inspect/json_line.hpp"
-#include "fieldguard/drivers/robosense_stream.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {

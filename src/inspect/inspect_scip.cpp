@@ -11,11 +11,11 @@
 #include <string_view>
 #include <vector>
 
+#include "fieldguard/drivers/scip.hpp"
+#include "fieldguard/drivers/scip_data.hpp"
 #include "inspect/inspect_byte_log.hpp"
 #include "inspect/inspect_format.hpp"
 #include "inspect/json_line.hpp"
-#include "fieldguard/drivers/scip.hpp"
-#include "fieldguard/drivers/scip_data.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {
@@ -132,7 +132,6 @@ class Decoder {
   std::uint64_t acks_ = 0;
   std::uint64_t from_sensor_bytes_ = 0;
 };
-
 
 }  // namespace
 

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "inspect/inspect_format.hpp"
-#include "inspect/json_line.hpp"
 #include "fieldguard/drivers/velodyne_position.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
+#include "inspect/inspect_format.hpp"
+#include "inspect/json_line.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {

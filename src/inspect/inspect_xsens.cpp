@@ -6,10 +6,10 @@
 #include <string>
 #include <variant>
 
+#include "fieldguard/drivers/xsens_stream.hpp"
 #include "inspect/inspect_byte_log.hpp"
 #include "inspect/inspect_format.hpp"
 #include "inspect/json_line.hpp"
-#include "fieldguard/drivers/xsens_stream.hpp"
 
 namespace fieldguard::app::inspect {
 namespace {
@@ -64,7 +64,8 @@ JsonLine sat_info_json(const xs::GnssSatInfo& s) {
   JsonLine j;
   j.field("itow_ms", s.itow_ms).field("num_svs", s.num_svs);
   JsonLine::Json sats = JsonLine::Json::array();
-  for (const auto& sv : s.satellites) sats.push_back(JsonLine::Json::array({sv.gnss_id, sv.sv_id, sv.cno_dbhz, sv.flags}));
+  for (const auto& sv : s.satellites)
+    sats.push_back(JsonLine::Json::array({sv.gnss_id, sv.sv_id, sv.cno_dbhz, sv.flags}));
   j.value("satellites", std::move(sats));  // [gnss_id, sv_id, cno_dbhz, flags] each
   return j;
 }
@@ -140,7 +141,8 @@ bool looks_like_xsens(ByteSpan head) {
   if (starts_with_byte_log(head)) {
     // What `fieldguard record` saves of the serial line; the source line names it ("ahrs /dev/ttyUSB0 ...").
     const std::string source = byte_log_source(head);
-    return source.find("ahrs") != std::string::npos || source.find("xsens") != std::string::npos || source.find("mti") != std::string::npos;
+    return source.find("ahrs") != std::string::npos || source.find("xsens") != std::string::npos ||
+           source.find("mti") != std::string::npos;
   }
   // A complete, valid Xbus frame anywhere in the first bytes, or an MTData2 header.
   for (std::size_t i = 0; i + 2 < head.size(); ++i) {

@@ -6,13 +6,12 @@
 // ASCII comes out escaped (\u00XX, \n, ...) and reads back as the same byte, and the line is always valid JSON.
 
 #include <concepts>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <utility>
-
-#include <nlohmann/json.hpp>
 
 namespace fieldguard::app {
 
@@ -23,10 +22,7 @@ class JsonLine {
   JsonLine& null(std::string_view k) { return set(k, nullptr); }
   JsonLine& field(std::string_view k, double v) { return set(k, v); }
   template <std::integral T>
-    requires(!std::same_as<T, bool>)
-  JsonLine& field(std::string_view k, T v) {
-    return set(k, v);
-  }
+  requires(!std::same_as<T, bool>) JsonLine& field(std::string_view k, T v) { return set(k, v); }
   JsonLine& field(std::string_view k, std::string_view v) { return set(k, bytes(v)); }
   JsonLine& field(std::string_view k, const char* v) { return field(k, std::string_view(v)); }
   template <typename T>

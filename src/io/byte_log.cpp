@@ -24,7 +24,8 @@ Expected<ByteLogWriter, std::string> ByteLogWriter::create(const std::string& pa
     if (c == '\n') c = ' ';
   }
   line += '\n';
-  if (std::fwrite(kByteLogMagic, 1, kMagicSize, f) != kMagicSize || std::fwrite(line.data(), 1, line.size(), f) != line.size()) {
+  if (std::fwrite(kByteLogMagic, 1, kMagicSize, f) != kMagicSize ||
+      std::fwrite(line.data(), 1, line.size(), f) != line.size()) {
     std::fclose(f);
     return Unexpected{"cannot write " + path};
   }
@@ -49,7 +50,8 @@ bool ByteLogWriter::write(Stamp host_time, Direction direction, ByteSpan bytes) 
   put_le(h, static_cast<std::uint64_t>(host_time.ns), 8);
   put_le(h + 8, bytes.size(), 4);
   h[12] = static_cast<std::uint8_t>(direction);
-  return std::fwrite(h, 1, sizeof h, file_) == sizeof h && std::fwrite(bytes.data(), 1, bytes.size(), file_) == bytes.size();
+  return std::fwrite(h, 1, sizeof h, file_) == sizeof h &&
+         std::fwrite(bytes.data(), 1, bytes.size(), file_) == bytes.size();
 }
 
 bool ByteLogWriter::flush() { return file_ != nullptr && std::fflush(file_) == 0; }
@@ -70,7 +72,9 @@ Expected<ByteLogReader, std::string> ByteLogReader::open(const std::string& path
 }
 
 ByteLogReader::ByteLogReader(ByteLogReader&& o) noexcept
-    : file_(std::exchange(o.file_, nullptr)), source_(std::move(o.source_)), truncated_(o.truncated_),
+    : file_(std::exchange(o.file_, nullptr)),
+      source_(std::move(o.source_)),
+      truncated_(o.truncated_),
       error_(std::move(o.error_)) {}
 ByteLogReader& ByteLogReader::operator=(ByteLogReader&& o) noexcept {
   if (this != &o) {

@@ -21,15 +21,18 @@ std::string errno_text(int e) { return std::strerror(e); }
 
 Expected<int, std::string> CanReader::open_socket(std::string_view iface, const std::vector<CanFilter>& filters) {
   const std::string name(iface);
-  if (name.empty() || name.size() >= IFNAMSIZ) return Unexpected{std::string("CAN interface name '" + name + "' is not valid")};
+  if (name.empty() || name.size() >= IFNAMSIZ)
+    return Unexpected{std::string("CAN interface name '" + name + "' is not valid")};
   const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
   if (fd < 0) {
-    return Unexpected{"cannot open a CAN_RAW socket: " + errno_text(errno) +
-                      (errno == EAFNOSUPPORT ? " (no SocketCAN in this kernel: load the can and can_raw modules)" : "")};
+    return Unexpected{
+        "cannot open a CAN_RAW socket: " + errno_text(errno) +
+        (errno == EAFNOSUPPORT ? " (no SocketCAN in this kernel: load the can and can_raw modules)" : "")};
   }
   std::vector<can_filter> kf;
   for (const CanFilter& f : filters) {
-    kf.push_back(can_filter{(f.id & CAN_EFF_MASK) | CAN_EFF_FLAG, (f.mask & CAN_EFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG});
+    kf.push_back(
+        can_filter{(f.id & CAN_EFF_MASK) | CAN_EFF_FLAG, (f.mask & CAN_EFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG});
   }
   if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, kf.empty() ? nullptr : kf.data(),
                    static_cast<socklen_t>(kf.size() * sizeof(can_filter))) != 0) {

@@ -2,16 +2,18 @@
 
 #include <vector>
 
-#include "io/clock.hpp"
-
 #include "fieldguard/drivers/scip.hpp"
 #include "fieldguard/drivers/scip_session.hpp"
+#include "io/clock.hpp"
 
 namespace fieldguard::io {
 
 struct ScipSource::Impl {
   Impl(boost::asio::io_context& io, ScipSourceOptions o, ScanHandler s, StateHandler st)
-      : options(std::move(o)), on_scan(std::move(s)), on_state(std::move(st)), session(options.client),
+      : options(std::move(o)),
+        on_scan(std::move(s)),
+        on_state(std::move(st)),
+        session(options.client),
         link(io, options.tcp,
              {.on_connected = [this] { connected(); },
               .on_data = [this](ByteSpan b, Stamp t) { data(b, t); },
@@ -55,8 +57,8 @@ struct ScipSource::Impl {
     if (!ev.refusals.empty()) {
       const auto& r = ev.refusals.front();
       ++stats.refusals;
-      link.reconnect("2D LiDAR refused " + std::string(scip::to_string(r.command)) + " with status " + r.status +
-                     " (" + std::string(r.text) + ")");
+      link.reconnect("2D LiDAR refused " + std::string(scip::to_string(r.command)) + " with status " + r.status + " (" +
+                     std::string(r.text) + ")");
       return;
     }
     send(ev.send);

@@ -25,7 +25,11 @@ std::string_view to_string(SerialState s) {
 // Shared with the pending asynchronous operations, so a handler that runs after stop() finds it alive.
 struct SerialReader::Impl : std::enable_shared_from_this<Impl> {
   Impl(boost::asio::io_context& io, SerialOptions o, Handler h, StateHandler s)
-      : port(io), reopen_timer(io), silence_timer(io), options(std::move(o)), handler(std::move(h)),
+      : port(io),
+        reopen_timer(io),
+        silence_timer(io),
+        options(std::move(o)),
+        handler(std::move(h)),
         on_state(std::move(s)) {}
 
   boost::asio::serial_port port;
@@ -38,7 +42,7 @@ struct SerialReader::Impl : std::enable_shared_from_this<Impl> {
   std::array<std::uint8_t, 4096> buffer{};
   bool running = false;
   bool failure_reported = false;  // the current run of failed opens has been reported once
-  std::uint64_t generation = 0;  // bumps on every close, so stale handlers of an old open do nothing
+  std::uint64_t generation = 0;   // bumps on every close, so stale handlers of an old open do nothing
 
   void set_state(SerialState s, const std::string& why) {
     if (stats.state.load() == s) return;
@@ -57,7 +61,8 @@ struct SerialReader::Impl : std::enable_shared_from_this<Impl> {
       port.close(ignored);
       const std::string why = "cannot open " + options.device + ": " + ec.message() + "; retrying every " +
                               std::to_string(options.reopen_interval_s) + " s";
-      if (!failure_reported && stats.state.load() == SerialState::Closed && on_state) on_state(SerialState::Closed, why);
+      if (!failure_reported && stats.state.load() == SerialState::Closed && on_state)
+        on_state(SerialState::Closed, why);
       failure_reported = true;
       set_state(SerialState::Closed, why);
       schedule_reopen();
@@ -82,7 +87,7 @@ struct SerialReader::Impl : std::enable_shared_from_this<Impl> {
     }
     if (!ec) {
       port.set_option(serial_port_base::stop_bits(options.stop_bits == 2 ? serial_port_base::stop_bits::two
-                                                                          : serial_port_base::stop_bits::one),
+                                                                         : serial_port_base::stop_bits::one),
                       ec);
     }
     if (!ec) port.set_option(serial_port_base::flow_control(serial_port_base::flow_control::none), ec);
@@ -101,17 +106,16 @@ struct SerialReader::Impl : std::enable_shared_from_this<Impl> {
       if (ec || !self->running || gen != self->generation) return;
       if (self->stats.state.load() == SerialState::Open) {
         ++self->stats.silences;
-        self->set_state(SerialState::Silent, self->options.device + " silent for " +
-                                                 std::to_string(self->options.silence_timeout_s) + " s");
+        self->set_state(SerialState::Silent,
+                        self->options.device + " silent for " + std::to_string(self->options.silence_timeout_s) + " s");
       }
     });
   }
 
   void read() {
     port.async_read_some(boost::asio::buffer(buffer),
-                         [self = shared_from_this(), gen = generation](const boost::system::error_code& ec, std::size_t n) {
-                           self->on_read(ec, n, gen);
-                         });
+                         [self = shared_from_this(), gen = generation](const boost::system::error_code& ec,
+                                                                       std::size_t n) { self->on_read(ec, n, gen); });
   }
 
   void on_read(const boost::system::error_code& ec, std::size_t n, std::uint64_t gen) {

@@ -7,9 +7,9 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/write.hpp>
 #include <chrono>
+#include <deque>
 
 #include "io/clock.hpp"
-#include <deque>
 
 namespace fieldguard::io {
 
@@ -31,12 +31,16 @@ namespace {
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
 
-
 }  // namespace
 
 struct TcpClient::Impl : std::enable_shared_from_this<Impl> {
   Impl(asio::io_context& io, TcpClientOptions o, Handlers h)
-      : socket(io), resolver(io), timer(io), silence(io), options(std::move(o)), handlers(std::move(h)),
+      : socket(io),
+        resolver(io),
+        timer(io),
+        silence(io),
+        options(std::move(o)),
+        handlers(std::move(h)),
         backoff_s(options.backoff_initial_s) {}
 
   tcp::socket socket;
@@ -77,16 +81,17 @@ struct TcpClient::Impl : std::enable_shared_from_this<Impl> {
         self->socket.close(ignored);  // the pending connect completes with operation_aborted
       }
     });
-    asio::async_connect(socket, endpoints, [self = shared_from_this(), gen](const boost::system::error_code& e, const tcp::endpoint&) {
-      if (!self->running || gen != self->generation) return;
-      self->timer.cancel();
-      if (e) {
-        self->fail_connect("cannot connect to " + self->peer() + ": " +
-                           (e == asio::error::operation_aborted ? std::string("timed out") : e.message()));
-        return;
-      }
-      self->on_connected();
-    });
+    asio::async_connect(
+        socket, endpoints, [self = shared_from_this(), gen](const boost::system::error_code& e, const tcp::endpoint&) {
+          if (!self->running || gen != self->generation) return;
+          self->timer.cancel();
+          if (e) {
+            self->fail_connect("cannot connect to " + self->peer() + ": " +
+                               (e == asio::error::operation_aborted ? std::string("timed out") : e.message()));
+            return;
+          }
+          self->on_connected();
+        });
   }
 
   void fail_connect(const std::string& why) {
@@ -129,8 +134,7 @@ struct TcpClient::Impl : std::enable_shared_from_this<Impl> {
                                                      const boost::system::error_code& e, std::size_t n) {
       if (!self->running || gen != self->generation) return;
       if (e) {
-        self->drop(e == asio::error::eof ? self->peer() + " closed the connection"
-                                         : self->peer() + ": " + e.message());
+        self->drop(e == asio::error::eof ? self->peer() + " closed the connection" : self->peer() + ": " + e.message());
         return;
       }
       const std::int64_t t = now_ns();

@@ -7,9 +7,9 @@ namespace fieldguard::io {
 namespace {
 
 constexpr std::uint16_t kEtherTypeIpv4 = 0x0800;
-constexpr std::uint16_t kEtherTypeVlan = 0x8100;      // 802.1Q customer tag
-constexpr std::uint16_t kEtherTypeQinQ = 0x88A8;      // 802.1ad service tag
-constexpr std::uint16_t kEtherTypeQinQOld = 0x9100;   // pre-802.1ad double tagging, still seen on switches
+constexpr std::uint16_t kEtherTypeVlan = 0x8100;     // 802.1Q customer tag
+constexpr std::uint16_t kEtherTypeQinQ = 0x88A8;     // 802.1ad service tag
+constexpr std::uint16_t kEtherTypeQinQOld = 0x9100;  // pre-802.1ad double tagging, still seen on switches
 constexpr std::size_t kEthernetHeader = 14;
 constexpr std::size_t kVlanTag = 4;
 constexpr std::size_t kSllHeader = 16;
@@ -65,16 +65,11 @@ struct LinkResult {
 
 [[nodiscard]] LinkResult ip_offset(int link_type, ByteSpan frame) {
   switch (link_type) {
-    case kLinkEthernet:
-      return ethernet_ip_offset(frame);
-    case kLinkLinuxSll:
-      return cooked_ip_offset(frame, kSllHeader, kSllProtocol);
-    case kLinkLinuxSll2:
-      return cooked_ip_offset(frame, kSll2Header, kSll2Protocol);
-    case kLinkRaw:
-      return raw_ip_offset(frame);
-    default:
-      return drop(FrameDrop::UnsupportedLink);
+    case kLinkEthernet: return ethernet_ip_offset(frame);
+    case kLinkLinuxSll: return cooked_ip_offset(frame, kSllHeader, kSllProtocol);
+    case kLinkLinuxSll2: return cooked_ip_offset(frame, kSll2Header, kSll2Protocol);
+    case kLinkRaw: return raw_ip_offset(frame);
+    default: return drop(FrameDrop::UnsupportedLink);
   }
 }
 
@@ -82,22 +77,14 @@ struct LinkResult {
 
 std::string_view to_string(FrameDrop d) {
   switch (d) {
-    case FrameDrop::TruncatedRecord:
-      return "truncated_record";
-    case FrameDrop::UnsupportedLink:
-      return "unsupported_link";
-    case FrameDrop::ShortLinkHeader:
-      return "short_link_header";
-    case FrameDrop::NotIpv4:
-      return "not_ipv4";
-    case FrameDrop::BadIpHeader:
-      return "bad_ip_header";
-    case FrameDrop::IpFragment:
-      return "ip_fragment";
-    case FrameDrop::NotUdp:
-      return "not_udp";
-    case FrameDrop::BadUdpLength:
-      return "bad_udp_length";
+    case FrameDrop::TruncatedRecord: return "truncated_record";
+    case FrameDrop::UnsupportedLink: return "unsupported_link";
+    case FrameDrop::ShortLinkHeader: return "short_link_header";
+    case FrameDrop::NotIpv4: return "not_ipv4";
+    case FrameDrop::BadIpHeader: return "bad_ip_header";
+    case FrameDrop::IpFragment: return "ip_fragment";
+    case FrameDrop::NotUdp: return "not_udp";
+    case FrameDrop::BadUdpLength: return "bad_udp_length";
   }
   return "unknown";
 }

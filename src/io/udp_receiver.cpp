@@ -64,8 +64,10 @@ struct UdpReceiver::Impl {
         } else if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
           std::uint32_t ovfl = 0;
           std::memcpy(&ovfl, CMSG_DATA(c), sizeof ovfl);
-          if (have_ovfl) stats.kernel_drops += static_cast<std::uint32_t>(ovfl - last_ovfl);
-          else stats.kernel_drops += ovfl;
+          if (have_ovfl)
+            stats.kernel_drops += static_cast<std::uint32_t>(ovfl - last_ovfl);
+          else
+            stats.kernel_drops += ovfl;
           last_ovfl = ovfl;
           have_ovfl = true;
         }

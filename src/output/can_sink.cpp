@@ -64,7 +64,8 @@ std::string candump_line(const CanFrame& f, Stamp t, std::string_view iface) {
 
 std::string check_interface_name(std::string_view iface) {
   if (iface.empty()) return "the CAN interface name is empty (e.g. can0)";
-  if (iface.size() >= IFNAMSIZ) return "the CAN interface name '" + std::string(iface) + "' is longer than 15 characters";
+  if (iface.size() >= IFNAMSIZ)
+    return "the CAN interface name '" + std::string(iface) + "' is longer than 15 characters";
   for (const char c : iface) {
     if (c == '/' || c == ':' || c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\0') {
       return "the CAN interface name '" + std::string(iface) + "' contains '/', ':', NUL or whitespace";
@@ -122,8 +123,8 @@ Expected<SocketCanSink, std::string> SocketCanSink::open(std::string_view iface)
   SocketCanSink sink(fd);  // closes fd on every early return below
   const unsigned index = ::if_nametoindex(name.c_str());
   if (index == 0) {
-    return Unexpected{"CAN interface " + name + ": " + errno_text(errno) +
-                      " (check `ip link show " + name + "` and the configured interface name)"};
+    return Unexpected{"CAN interface " + name + ": " + errno_text(errno) + " (check `ip link show " + name +
+                      "` and the configured interface name)"};
   }
   // We only send: no data frames in, only the error classes the sink counts.
   if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, nullptr, 0) != 0) {

@@ -56,14 +56,15 @@ std::string dbc_text(const CanParams& params) {
   }
 
   o += "CM_ " +
-       quoted("fieldguard obstacle detection to the steering controller. Generated from src/output/can_layout.cpp "
-              "(tools/fieldguard-dbc); do not edit. 29-bit J1939 identifiers: BO_ ids have bit 31 set (id | "
-              "0x80000000). Source address " +
-              hex2(params.source_address) + ", steering controller " + hex2(params.controller_address) +
-              ". Signals are little-endian (Intel) as J1939 sends multi-byte parameters.") +
+       quoted(
+           "fieldguard obstacle detection to the steering controller. Generated from src/output/can_layout.cpp "
+           "(tools/fieldguard-dbc); do not edit. 29-bit J1939 identifiers: BO_ ids have bit 31 set (id | "
+           "0x80000000). Source address " +
+           hex2(params.source_address) + ", steering controller " + hex2(params.controller_address) +
+           ". Signals are little-endian (Intel) as J1939 sends multi-byte parameters.") +
        ";\n";
-  o += "CM_ BU_ " + std::string(kNode) + " " + quoted("The fieldguard daemon, J1939 address " + hex2(params.source_address)) +
-       ";\n";
+  o += "CM_ BU_ " + std::string(kNode) + " " +
+       quoted("The fieldguard daemon, J1939 address " + hex2(params.source_address)) + ";\n";
   o += "CM_ BU_ " + std::string(kController) + " " +
        quoted("Auto-steer controller, J1939 address " + hex2(params.controller_address)) + ";\n";
   for (const MessageLayout& m : message_layouts()) {

@@ -39,7 +39,8 @@ RingJitter RingJitterMeter::measure(const Cloud& cloud, std::span<const std::uin
     // (Across the bearing seam behind the sensor the span is nearly a full turn: wide, never a needle.)
     out.width_m = (b1 - b0) * static_cast<float>(rsum / static_cast<double>(samples_.size()));
   }
-  std::sort(samples_.begin(), samples_.end(), [](const Sample& a, const Sample& b) { return a.elevation < b.elevation; });
+  std::sort(samples_.begin(), samples_.end(),
+            [](const Sample& a, const Sample& b) { return a.elevation < b.elevation; });
   offs_.clear();
   std::size_t g0 = 0;
   while (g0 < samples_.size()) {

@@ -1,10 +1,9 @@
 // Clusters regrouped: from per-point cluster numbers or labels, and merged by a target per cluster.
-#include "fieldguard/perception/euclidean_cluster.hpp"
-
 #include <algorithm>
 #include <cstring>
 #include <utility>
 
+#include "fieldguard/perception/euclidean_cluster.hpp"
 #include "perception/simd.hpp"
 
 namespace fieldguard::perception {

@@ -161,15 +161,16 @@ std::uint32_t ClusterJoiner::join(const Cloud& cloud, std::span<const float> hei
   if (params_.stacked) {
     // 3. Stacked: x-y boxes that overlap, or nearly (stack_margin_m on each axis).
     const auto margin = static_cast<float>(params_.stack_margin_m);
-    sweep([&](std::size_t c) { return !info_[c].empty; }, margin, [&](std::uint32_t a, std::uint32_t b) {
-      const Info& p = info_[a];
-      const Info& q = info_[b];
-      if (!(p.floats || q.floats)) return;
-      const float gx = std::max(p.lo[0], q.lo[0]) - std::min(p.hi[0], q.hi[0]);
-      const float gy = std::max(p.lo[1], q.lo[1]) - std::min(p.hi[1], q.hi[1]);
-      if (gx > margin || gy > margin) return;
-      joined += unite(a, b) ? 1U : 0U;
-    });
+    sweep([&](std::size_t c) { return !info_[c].empty; }, margin,
+          [&](std::uint32_t a, std::uint32_t b) {
+            const Info& p = info_[a];
+            const Info& q = info_[b];
+            if (!(p.floats || q.floats)) return;
+            const float gx = std::max(p.lo[0], q.lo[0]) - std::min(p.hi[0], q.hi[0]);
+            const float gy = std::max(p.lo[1], q.lo[1]) - std::min(p.hi[1], q.hi[1]);
+            if (gx > margin || gy > margin) return;
+            joined += unite(a, b) ? 1U : 0U;
+          });
   }
   if (joined == 0) return 0;
 

@@ -233,13 +233,12 @@ void crop(std::span<const LidarPoint> in, const Box3& roi, const Box3& body, Clo
                                                                      : std::max(body_front, roi_back);
   const simd::f32x4 ahead = simd::splat(front);
   // A finite ROI already rejects NaN and infinity; only an unbounded one needs the explicit test.
-  const std::size_t k = is_finite(roi)
-                            ? crop_points<false, split, count>(in.data(), n, keep, drop, keep4, drop4, ahead,
-                                                               out.x.data(), out.y.data(), out.z.data(),
-                                                               out.ring.data(), scan2d, near, near_count)
-                            : crop_points<true, split, count>(in.data(), n, keep, drop, keep4, drop4, ahead,
-                                                              out.x.data(), out.y.data(), out.z.data(),
-                                                              out.ring.data(), scan2d, near, near_count);
+  const std::size_t k =
+      is_finite(roi)
+          ? crop_points<false, split, count>(in.data(), n, keep, drop, keep4, drop4, ahead, out.x.data(), out.y.data(),
+                                             out.z.data(), out.ring.data(), scan2d, near, near_count)
+          : crop_points<true, split, count>(in.data(), n, keep, drop, keep4, drop4, ahead, out.x.data(), out.y.data(),
+                                            out.z.data(), out.ring.data(), scan2d, near, near_count);
   out.x.resize(k);
   out.y.resize(k);
   out.z.resize(k);

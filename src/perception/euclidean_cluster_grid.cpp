@@ -1,6 +1,4 @@
 // EuclideanClusterer over a grid of cells (ClusterStructure::Grid): the same clusters as the k-d tree.
-#include "fieldguard/perception/euclidean_cluster.hpp"
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -8,6 +6,7 @@
 #include <limits>
 #include <numbers>
 
+#include "fieldguard/perception/euclidean_cluster.hpp"
 #include "perception/euclidean_cluster_radius.hpp"
 #include "perception/simd.hpp"
 
@@ -166,8 +165,8 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     }
   }
   for (std::size_t i = i4; i < n; ++i) {
-    const std::size_t c = std::min<std::size_t>(cell(in.x[i], lo[0]), nx - 1) * ny +
-                          std::min<std::size_t>(cell(in.y[i], lo[1]), ny - 1);
+    const std::size_t c =
+        std::min<std::size_t>(cell(in.x[i], lo[0]), nx - 1) * ny + std::min<std::size_t>(cell(in.y[i], lo[1]), ny - 1);
     cell_of_[i] = static_cast<std::uint32_t>(c);
     z_of_[i] = std::min(cell(in.z[i], lo[2]), nz_top);
   }
@@ -221,7 +220,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     const auto grow4 = [&](f32x4 g, f32x4 cap, f32x4 range) {
       const f32x4 gr = g * range;
       const f32x4 m = vt < gr ? gr : vt;  // std::max(t, g * range)
-      return m < cap ? m : cap;         // std::min(cap, that)
+      return m < cap ? m : cap;           // std::min(cap, that)
     };
     const auto squared4 = [&](f32x4 radius) { return radius == vt ? base_r2 : radius * radius; };
     const bool adaptive = adaptive_;
@@ -383,7 +382,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     st[a] = Stencil{hreach, zs[a].iz > reach ? zs[a].iz - reach : 0U, zs[a].iz_top + reach};
   }
   // Whether cell a joins cell b (b before a, in a's stencil), and if so the join: ra is a's root, kept up to date.
-  const auto visit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t& ra) __attribute__((always_inline)) {
+  const auto visit = [&](std::uint32_t a, std::uint32_t b, std::uint32_t & ra) __attribute__((always_inline)) {
     // Many cells that get here are in a's cluster already, pointing straight at its root: that ends here without
     // the walk. (Skipping the walk's path halving changes which ancestor a cell points at, never its root: the
     // clusters are the same.)
@@ -469,7 +468,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
         if (ra == before) continue;
         joined = true;
         if (b_root != kNoCluster) {
-          b_root = ra;  // the joined cluster's root: a's and b's, whichever is lower
+          b_root = ra;                 // the joined cluster's root: a's and b's, whichever is lower
           if (a_root != kNoCluster) {  // both columns whole in one cluster
             a_root = ra;
             return;

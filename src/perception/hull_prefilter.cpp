@@ -38,11 +38,11 @@ struct HullDirs {
 // The pre-filter for a footprint drop_interior() does not vouch for (a coordinate not finite or beyond
 // kFilterReach), kept as it was before the octagon so that such a footprint's hull stays what it was: with NaN
 // the monotone chain's result depends on which points it sees. It leaves out of `all` the points that cannot be
-// hull vertices, into `kept` (input order): the points extreme along 16 directions span a polygon inside the hull, and a point strictly inside every edge of it is no hull
-// vertex (strictly left of every edge of a closed chain of input points means inside their hull, whatever
-// their order). The test is in float, so a point is left out only when it is inside by a margin far above the
-// float error of the test; points on or near an edge are kept and the exact hull below decides.
-// Most of a dense footprint (a wall of thousands of points) is left out.
+// hull vertices, into `kept` (input order): the points extreme along 16 directions span a polygon inside the hull, and
+// a point strictly inside every edge of it is no hull vertex (strictly left of every edge of a closed chain of input
+// points means inside their hull, whatever their order). The test is in float, so a point is left out only when it is
+// inside by a margin far above the float error of the test; points on or near an edge are kept and the exact hull below
+// decides. Most of a dense footprint (a wall of thousands of points) is left out.
 void drop_interior_16(std::span<const P2> all, std::vector<P2>& kept) {
   static const HullDirs dirs;
   const std::size_t n = all.size();
@@ -231,7 +231,8 @@ void refine(std::vector<P2>& kept, std::span<const P2> corners, float ox, float 
   if (c == m) return;  // nothing outside any edge: the same polygon again
   std::array<simd::f32x4, kMax> ex{}, ey{}, limit{};
   for (std::size_t k = 0; k < kMax; ++k) {
-    const EdgeLine l = k < c ? edge_line(chain[k], chain[(k + 1) % c], ox, oy, span) : edge_line(chain[0], chain[1], ox, oy, span);
+    const EdgeLine l =
+        k < c ? edge_line(chain[k], chain[(k + 1) % c], ox, oy, span) : edge_line(chain[0], chain[1], ox, oy, span);
     ex[k] = simd::splat(l.dx);
     ey[k] = simd::splat(l.dy);
     limit[k] = simd::splat(l.limit);
@@ -242,10 +243,12 @@ void refine(std::vector<P2>& kept, std::span<const P2> corners, float ox, float 
     simd::f32x4 a, b;
     std::memcpy(&a, &kept[i], sizeof a);
     std::memcpy(&b, &kept[i + 2], sizeof b);
-    const simd::f32x4 qx = __builtin_shufflevector(a, b, 0, 2, 4, 6) - vox, qy = __builtin_shufflevector(a, b, 1, 3, 5, 7) - voy;
+    const simd::f32x4 qx = __builtin_shufflevector(a, b, 0, 2, 4, 6) - vox,
+                      qy = __builtin_shufflevector(a, b, 1, 3, 5, 7) - voy;
     const auto left = [&](std::size_t k) { return (ex[k] * qy - ey[k] * qx) > limit[k]; };
-    const simd::i32x4 inside = ((left(0) & left(1)) & (left(2) & left(3))) & ((left(4) & left(5)) & (left(6) & left(7))) &
-                               ((left(8) & left(9)) & (left(10) & left(11))) & ((left(12) & left(13)) & (left(14) & left(15)));
+    const simd::i32x4 inside =
+        ((left(0) & left(1)) & (left(2) & left(3))) & ((left(4) & left(5)) & (left(6) & left(7))) &
+        ((left(8) & left(9)) & (left(10) & left(11))) & ((left(12) & left(13)) & (left(14) & left(15)));
     const unsigned mask = simd::mask_bits(inside);
     for (std::size_t j = 0; j < 4; ++j) {
       if ((mask & (1U << j)) == 0U) kept[w++] = kept[i + j];
@@ -327,7 +330,8 @@ Seen drop_interior(std::span<const P2> all, std::vector<P2>& kept, std::vector<f
     for (std::size_t k = 0; k < kExt; ++k) best[k] = std::max(best[k], sign[k] * project(all[i][0], all[i][1], k));
   }
   const float min_x = -best[4], max_x = best[0], min_y = -best[6], max_y = best[2];
-  const float reach = std::max(std::max(std::fabs(min_x), std::fabs(max_x)), std::max(std::fabs(min_y), std::fabs(max_y)));
+  const float reach =
+      std::max(std::max(std::fabs(min_x), std::fabs(max_x)), std::max(std::fabs(min_y), std::fabs(max_y)));
   if (!finite || !(reach <= kFilterReach)) {
     drop_interior_16(all, kept);
     return Seen{false, reach};

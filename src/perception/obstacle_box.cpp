@@ -94,8 +94,10 @@ void maybe_uncounted(std::span<const P2> pts, std::span<const Candidate* const> 
   if (bu0 > bu1) return;
   const float margin = 1e-5F * (reach + 1.F);
   const simd::f32x4 fa = simd::splat(static_cast<float>(ax)), fb = simd::splat(static_cast<float>(ay));
-  const simd::f32x4 lu = simd::splat(static_cast<float>(bu0) - margin), hu = simd::splat(static_cast<float>(bu1) + margin);
-  const simd::f32x4 lv = simd::splat(static_cast<float>(bv0) - margin), hv = simd::splat(static_cast<float>(bv1) + margin);
+  const simd::f32x4 lu = simd::splat(static_cast<float>(bu0) - margin),
+                    hu = simd::splat(static_cast<float>(bu1) + margin);
+  const simd::f32x4 lv = simd::splat(static_cast<float>(bv0) - margin),
+                    hv = simd::splat(static_cast<float>(bv1) + margin);
   const std::size_t n = pts.size();
   std::size_t i = 0;
   for (; i + 4 <= n; i += 4) {

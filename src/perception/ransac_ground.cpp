@@ -111,12 +111,15 @@ void RansacGround::segment(const Cloud& in, GroundLabels& out) {
       mean /= static_cast<double>(inliers_.size());
       Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
       for (const std::uint32_t i : inliers_) {
-        const Eigen::Vector3d q = Eigen::Vector3d(static_cast<double>(x[i]), static_cast<double>(y[i]), static_cast<double>(z[i])) - mean;
+        const Eigen::Vector3d q =
+            Eigen::Vector3d(static_cast<double>(x[i]), static_cast<double>(y[i]), static_cast<double>(z[i])) - mean;
         cov.noalias() += q * q.transpose();
       }
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
       Eigen::Vector3d nrm = eig.eigenvectors().col(0);  // eigenvalues ascending
-      if (!nrm.allFinite() || nrm.norm() < 0.5) nrm = Eigen::Vector3d(static_cast<double>(best_plane[0]), static_cast<double>(best_plane[1]), static_cast<double>(best_plane[2]));
+      if (!nrm.allFinite() || nrm.norm() < 0.5)
+        nrm = Eigen::Vector3d(static_cast<double>(best_plane[0]), static_cast<double>(best_plane[1]),
+                              static_cast<double>(best_plane[2]));
       nrm.normalize();
       if (nrm.z() < 0.0) nrm = -nrm;
       coeff_ = {static_cast<float>(nrm.x()), static_cast<float>(nrm.y()), static_cast<float>(nrm.z()),

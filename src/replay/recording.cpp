@@ -34,7 +34,8 @@ std::optional<RecordingEvent> RecordingReader::next() {
       best = static_cast<int>(i);
     }
   }
-  const bool capture = datagram_ && (best < 0 || datagram_->host_time.ns <= cursors_[static_cast<std::size_t>(best)].next->host_time.ns);
+  const bool capture =
+      datagram_ && (best < 0 || datagram_->host_time.ns <= cursors_[static_cast<std::size_t>(best)].next->host_time.ns);
   if (capture) {
     taken_ = -1;
     return RecordingEvent{datagram_->host_time, &*datagram_, nullptr, LogKind::Scan2d};

@@ -1,5 +1,7 @@
 // `fieldguard replay`: captured packets through the same decoders the daemon runs live.
 
+#include "fieldguard/replay/replay.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,34 +20,32 @@
 #include <tuple>
 #include <vector>
 
-#include "fieldguard/writers/bev.hpp"
+#include "fieldguard/config/config.hpp"
+#include "fieldguard/core/exit_code.hpp"
+#include "fieldguard/drivers/velodyne_position.hpp"
+#include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/engine/can_stage.hpp"
 #include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/engine/logging.hpp"
+#include "fieldguard/engine/samples.hpp"
+#include "fieldguard/engine/stage_times.hpp"
+#include "fieldguard/io/byte_log.hpp"
+#include "fieldguard/io/pcap_reader.hpp"
+#include "fieldguard/output/can_sink.hpp"
+#include "fieldguard/perception/obstacle_hold.hpp"
+#include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/sync/ordered_pool.hpp"
+#include "fieldguard/sync/synchronizer.hpp"
+#include "fieldguard/writers/bev.hpp"
 #include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "fieldguard/writers/pcd_writer.hpp"
 #include "fieldguard/writers/png_writer.hpp"
 #include "replay/recording.hpp"
-#include "fieldguard/engine/samples.hpp"
-#include "fieldguard/engine/stage_times.hpp"
-#include "fieldguard/io/byte_log.hpp"
-#include "fieldguard/perception/pipeline.hpp"
-#include "fieldguard/config/config.hpp"
-#include "fieldguard/drivers/velodyne_position.hpp"
-#include "fieldguard/drivers/velodyne_stream.hpp"
-#include "fieldguard/io/pcap_reader.hpp"
-#include "fieldguard/replay/replay.hpp"
-#include "fieldguard/core/exit_code.hpp"
-#include "fieldguard/output/can_sink.hpp"
-#include "fieldguard/perception/obstacle_hold.hpp"
-#include "fieldguard/sync/ordered_pool.hpp"
-#include "fieldguard/sync/synchronizer.hpp"
 
 namespace fieldguard::app {
 namespace {
 
 namespace fs = std::filesystem;
-
 
 struct PositionCounters {
   std::uint64_t packets = 0;
@@ -108,7 +108,8 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
     dropped += n;
     reasons += "    " + name + std::string(name.size() < 24 ? 24 - name.size() : 1, ' ') + std::to_string(n) + "\n";
   };
-  for (std::size_t i = 0; i < io::kFrameDropCount; ++i) add(std::string(io::to_string(static_cast<io::FrameDrop>(i))), ps.drops[i]);
+  for (std::size_t i = 0; i < io::kFrameDropCount; ++i)
+    add(std::string(io::to_string(static_cast<io::FrameDrop>(i))), ps.drops[i]);
   add("other_port", ports.other_port);
   add("data_bad_length", ports.data_bad_length);
   add("position_bad_length", pos.bad_length);
@@ -213,9 +214,9 @@ class Replay {
   std::optional<DetectorSet> detectors_;
   std::optional<Pool> pool_;
   std::vector<FrameJob> jobs_;
-  perception::ObstacleHold hold_;  // frame to frame, so here in frame order and not in the workers
+  perception::ObstacleHold hold_;           // frame to frame, so here in frame order and not in the workers
   std::vector<perception::Obstacle> held_;  // one frame's held obstacles, for its picture
-  std::array<HeardTimes, 3> heard_;  // scan2d, gnss, ahrs: LogKind order
+  std::array<HeardTimes, 3> heard_;         // scan2d, gnss, ahrs: LogKind order
   std::deque<TimedProblem> problems_;
   // Counts for the summary.
   PositionCounters pos_;
@@ -235,7 +236,8 @@ class Replay {
 bool Replay::open() {
   const std::string session_dir = opt_.session.value_or("");
   if (!session_dir.empty() && !fs::is_directory(session_dir)) {
-    std::fprintf(stderr, "fieldguard replay: %s is not a directory written by `fieldguard record`\n", session_dir.c_str());
+    std::fprintf(stderr, "fieldguard replay: %s is not a directory written by `fieldguard record`\n",
+                 session_dir.c_str());
     return false;
   }
   pcap_path_ = session_dir.empty() ? *opt_.pcap : (fs::path(session_dir) / "lidar.pcap").string();
@@ -247,7 +249,8 @@ bool Replay::open() {
     }
   }
   const std::tuple<const char*, LogKind, const std::optional<std::string>&> kLogNames[] = {
-      {"scan2d", LogKind::Scan2d, opt_.scan2d_log}, {"gnss", LogKind::Gnss, opt_.gnss_log},
+      {"scan2d", LogKind::Scan2d, opt_.scan2d_log},
+      {"gnss", LogKind::Gnss, opt_.gnss_log},
       {"ahrs", LogKind::Ahrs, opt_.ahrs_log}};
   for (const auto& [name, kind, given] : kLogNames) {
     if (given) {
@@ -383,8 +386,8 @@ void Replay::write_frame(const Pool::Result& r) {
 
 // The safety monitor on one frame, with every sensor as it was heard at the frame's decision time.
 void Replay::decide(const Pool::Result& r, const LidarFrame& f, perception::FrameResult& result) {
-  static constexpr output::safety::Sensor kHeardSensor[] = {
-      output::safety::Sensor::Scan2d, output::safety::Sensor::Gnss, output::safety::Sensor::Ahrs};
+  static constexpr output::safety::Sensor kHeardSensor[] = {output::safety::Sensor::Scan2d,
+                                                            output::safety::Sensor::Gnss, output::safety::Sensor::Ahrs};
   for (std::size_t i = 0; i < heard_.size(); ++i) {
     const Stamp t = heard_[i].at(r.input->complete);
     if (t.ns != 0) can_->sensor_data(kHeardSensor[i], t);  // NOLINT(clang-analyzer-core.CallAndMessage): i < 3
@@ -496,8 +499,8 @@ void Replay::read() {
 void Replay::print_fusion_summary() const {
   for (const auto& l : recording_->logs()) {
     std::printf("  %-17s %llu records (%s)%s%s\n", fs::path(l.file.path).filename().c_str(),
-                static_cast<unsigned long long>(l.records), l.source.c_str(), l.truncated ? ", cut short at the end" : "",
-                l.error.empty() ? "" : (", " + l.error).c_str());
+                static_cast<unsigned long long>(l.records), l.source.c_str(),
+                l.truncated ? ", cut short at the end" : "", l.error.empty() ? "" : (", " + l.error).c_str());
   }
   if (!logs_.empty()) {
     const auto& fc = fusion_->counts();
@@ -505,19 +508,22 @@ void Replay::print_fusion_summary() const {
                 static_cast<unsigned long long>(fc.scans), static_cast<unsigned long long>(fc.gnss),
                 static_cast<unsigned long long>(fc.ahrs));
     if (fc.scan_errors + fc.gnss_errors + fc.ahrs_errors != 0) {
-      std::printf("  sample errors     %llu scan2d, %llu gnss, %llu ahrs\n", static_cast<unsigned long long>(fc.scan_errors),
-                  static_cast<unsigned long long>(fc.gnss_errors), static_cast<unsigned long long>(fc.ahrs_errors));
+      std::printf("  sample errors     %llu scan2d, %llu gnss, %llu ahrs\n",
+                  static_cast<unsigned long long>(fc.scan_errors), static_cast<unsigned long long>(fc.gnss_errors),
+                  static_cast<unsigned long long>(fc.ahrs_errors));
     }
   }
   if (const sync::Synchronizer* sy = fusion_->synchronizer()) {
     const auto& ac = sy->assembler().counters();
-    std::printf("  fused frames      %llu at %.3g Hz: %llu complete, %llu timed out (", static_cast<unsigned long long>(ac.frames),
-                cfg_.sync.rate_hz, static_cast<unsigned long long>(ac.complete), static_cast<unsigned long long>(ac.timed_out));
+    std::printf("  fused frames      %llu at %.3g Hz: %llu complete, %llu timed out (",
+                static_cast<unsigned long long>(ac.frames), cfg_.sync.rate_hz,
+                static_cast<unsigned long long>(ac.complete), static_cast<unsigned long long>(ac.timed_out));
     bool first = true;
     for (const sync::SensorKind k : sync::kAllSensors) {
       const auto n = ac.missing[static_cast<std::size_t>(k)];
       if (n == 0) continue;
-      std::printf("%s%llu lacking %s", first ? "" : ", ", static_cast<unsigned long long>(n), std::string(sync::to_string(k)).c_str());
+      std::printf("%s%llu lacking %s", first ? "" : ", ", static_cast<unsigned long long>(n),
+                  std::string(sync::to_string(k)).c_str());
       first = false;
     }
     std::printf("%s), %llu late rotations dropped\n", first ? "none lacking a sensor" : "",
@@ -542,14 +548,16 @@ int Replay::finish() {
   std::printf("  workers           %zu, %llu frames lost\n", workers_, static_cast<unsigned long long>(lost_));
   if (can_) {
     const auto& cc = can_->counts();
-    std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", static_cast<unsigned long long>(cc.stop_frames),
-                static_cast<unsigned long long>(cc.go_frames), static_cast<unsigned long long>(cc.changes));
+    std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n",
+                static_cast<unsigned long long>(cc.stop_frames), static_cast<unsigned long long>(cc.go_frames),
+                static_cast<unsigned long long>(cc.changes));
     std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log_->stats().sent));
   }
   print_fusion_summary();
   if (samples_) samples_->finish();
 
-  if (pcap_stats.truncated) log_->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path_);
+  if (pcap_stats.truncated)
+    log_->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path_);
   if (!pcap_stats.read_error.empty()) log_->warn("{}: reading stopped early: {}", pcap_path_, pcap_stats.read_error);
   if (cfg_.lidar.model != velodyne::Model::Unknown && stream.detector().decided() &&
       *stream.detector().decided() != cfg_.lidar.model) {
@@ -563,8 +571,10 @@ int Replay::finish() {
   }
   if (!logs_.empty() && stream.counters().packets == 0) return kExitOk;  // a recording without 3D LiDAR data
   if (stream.counters().packets == 0) {
-    std::fprintf(stderr, "fieldguard replay: %s holds no UDP datagram to the data port %u: not a Velodyne capture, or "
-                 "lidar.data_port is wrong\n", pcap_path_.c_str(), cfg_.lidar.data_port);
+    std::fprintf(stderr,
+                 "fieldguard replay: %s holds no UDP datagram to the data port %u: not a Velodyne capture, or "
+                 "lidar.data_port is wrong\n",
+                 pcap_path_.c_str(), cfg_.lidar.data_port);
     return kExitBadInput;
   }
   if (stream.counters().decoded == 0) {

@@ -164,8 +164,9 @@ Mapping ClockModel::observe(std::int64_t sensor_ns, Stamp host) {
   if (std::abs(residual_s) > params_.jump_threshold_s) {
     suspects_.push_back(Suspect{sensor_ns, host, residual_s});
     if (suspects_.size() > static_cast<std::size_t>(params_.jump_confirm)) suspects_.pop_front();
-    const auto [lo, hi] = std::minmax_element(suspects_.begin(), suspects_.end(),
-                                              [](const Suspect& a, const Suspect& b) { return a.residual_s < b.residual_s; });
+    const auto [lo, hi] =
+        std::minmax_element(suspects_.begin(), suspects_.end(),
+                            [](const Suspect& a, const Suspect& b) { return a.residual_s < b.residual_s; });
     const bool agree = hi->residual_s - lo->residual_s <= params_.jump_threshold_s;
     if (suspects_.size() == static_cast<std::size_t>(params_.jump_confirm) && agree) {
       const std::deque<Suspect> pending = std::move(suspects_);

@@ -209,8 +209,8 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
 
   const Stamp mid = f.middle();
   if (!scans_.empty()) {
-    auto it = std::lower_bound(scans_.begin(), scans_.end(), mid,
-                               [](const TimedScan& e, Stamp t) { return e.time < t; });
+    auto it =
+        std::lower_bound(scans_.begin(), scans_.end(), mid, [](const TimedScan& e, Stamp t) { return e.time < t; });
     if (it == scans_.end() || (it != scans_.begin() && mid.ns - std::prev(it)->time.ns <= it->time.ns - mid.ns)) {
       --it;
     }

@@ -52,8 +52,8 @@ Image render_bev(std::span<const perception::LabeledPoint> points, const percept
 
   for (const auto& pt : points) {
     const bool ground = pt.label == perception::PointLabel::Ground;
-    const Rgb c = ground ? Rgb{60, 60, 60}
-                         : height_colour(pt.z, pt.label == perception::PointLabel::Obstacle ? 1.F : 0.55F);
+    const Rgb c =
+        ground ? Rgb{60, 60, 60} : height_colour(pt.z, pt.label == perception::PointLabel::Obstacle ? 1.F : 0.55F);
     img.set(p.col(static_cast<double>(pt.y)), p.row(static_cast<double>(pt.x)), c);
   }
 
@@ -84,8 +84,8 @@ void draw_obstacles(Image& img, std::span<const perception::Obstacle> obstacles,
     for (int i = 0; i < 4; ++i) {
       const auto& a = corners[i];
       const auto& b = corners[(i + 1) % 4];
-      img.line(p.col(cy0 + a[0] * sy + a[1] * cy), p.row(cx0 + a[0] * cy - a[1] * sy), p.col(cy0 + b[0] * sy + b[1] * cy),
-               p.row(cx0 + b[0] * cy - b[1] * sy), c);
+      img.line(p.col(cy0 + a[0] * sy + a[1] * cy), p.row(cx0 + a[0] * cy - a[1] * sy),
+               p.col(cy0 + b[0] * sy + b[1] * cy), p.row(cx0 + b[0] * cy - b[1] * sy), c);
     }
     char label[32];
     std::snprintf(label, sizeof label, "%.1fm", static_cast<double>(o.distance_m));

@@ -88,8 +88,8 @@ void plane_json(std::string& s, const perception::Obstacle& o, const perception:
 
 }  // namespace
 
-std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result, const FusionInfo* fusion,
-                                const Mounting* lidar) {
+std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result,
+                                const FusionInfo* fusion, const Mounting* lidar) {
   std::string s = "{\"frame\":" + std::to_string(frame.index) + ",\"stamp\":";
   num(s, frame.host_stamp.seconds(), 6);
   s += ",\"partial\":";
@@ -125,7 +125,8 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
     s += perception::to_string(o.size_class);
     s += '"';
     // Only frames that carry a 2D scan can have it: a 3D LiDAR's output keeps its old bytes.
-    if ((o.sources & perception::kSeenBy2d) != 0) s += (o.sources & perception::kSeenBy3d) != 0 ? ",\"seen_by\":\"3d+2d\"" : ",\"seen_by\":\"2d\"";
+    if ((o.sources & perception::kSeenBy2d) != 0)
+      s += (o.sources & perception::kSeenBy3d) != 0 ? ",\"seen_by\":\"3d+2d\"" : ",\"seen_by\":\"2d\"";
     // Only where the hold reported it (obstacle_hold.hpp): the filters' obstacles keep their bytes.
     if (o.held) s += ",\"held\":true";
     if (pose) plane_json(s, o, *pose);

@@ -21,8 +21,9 @@ struct PcdPoint {
 }  // namespace fieldguard::app
 
 POINT_CLOUD_REGISTER_POINT_STRUCT(fieldguard::app::PcdPoint,
-                                  (float, x, x)(float, y, y)(float, z, z)(float, intensity, intensity)(
-                                      std::uint16_t, ring, ring)(float, time, time))
+                                  (float, x, x)(float, y, y)(float, z, z)(float, intensity,
+                                                                          intensity)(std::uint16_t, ring,
+                                                                                     ring)(float, time, time))
 
 namespace fieldguard::app {
 

@@ -5,8 +5,8 @@
 #include <string>
 
 #include "app/config_issues.hpp"
-#include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/config/config.hpp"
+#include "fieldguard/engine/fusion.hpp"
 
 namespace fieldguard::app {
 namespace {

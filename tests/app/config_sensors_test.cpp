@@ -63,16 +63,16 @@ ahrs:
 
 TEST(ConfigSensors, ReportsEveryProblemWithLineAndKey) {
   const std::string text =
-      "scan2d:\n"                      // 1
-      "  start_step: 900\n"            // 2
-      "  end_step: 100\n"              // 3  end < start
-      "  port: 0\n"                    // 4  out of range
-      "gnss:\n"                        // 5
-      "  enabled: yes please\n"        // 6  not a boolean
-      "  baud: 12345\n"                // 7  not a baud rate
-      "  framing: 9X3\n"               // 8
-      "ahrs:\n"                        // 9
-      "  enabled: true\n"              // 10 no device
+      "scan2d:\n"                        // 1
+      "  start_step: 900\n"              // 2
+      "  end_step: 100\n"                // 3  end < start
+      "  port: 0\n"                      // 4  out of range
+      "gnss:\n"                          // 5
+      "  enabled: yes please\n"          // 6  not a boolean
+      "  baud: 12345\n"                  // 7  not a baud rate
+      "  framing: 9X3\n"                 // 8
+      "ahrs:\n"                          // 9
+      "  enabled: true\n"                // 10 no device
       "  mounting: {pitch_deg: 120}\n";  // 11
   const auto r = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(r, "scan2d.end_step", "must not be less than start_step", 3)) << dump(r);

@@ -1,4 +1,3 @@
-#include "app/config_issues.hpp"
 #include "fieldguard/config/config.hpp"
 
 #include <gtest/gtest.h>
@@ -8,6 +7,8 @@
 #include <fstream>
 #include <string>
 #include <vector>
+
+#include "app/config_issues.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -269,13 +270,13 @@ TEST(ConfigLoad, TheHoldKeys) {
   EXPECT_EQ(d.config.perception.hold.gate_m, 0.3);
   EXPECT_EQ(d.config.perception.hold.min_points, 2);
   const std::string text =
-      "perception:\n"            // 1
-      "  hold:\n"                // 2
-      "    enabled: maybe\n"     // 3 not true or false
-      "    max_age_s: -0.1\n"    // 4 out of range
-      "    gate_m: 4\n"          // 5 out of range
-      "    min_points: 0\n"      // 6 out of range
-      "    max_age: 1\n";        // 7 unknown
+      "perception:\n"          // 1
+      "  hold:\n"              // 2
+      "    enabled: maybe\n"   // 3 not true or false
+      "    max_age_s: -0.1\n"  // 4 out of range
+      "    gate_m: 4\n"        // 5 out of range
+      "    min_points: 0\n"    // 6 out of range
+      "    max_age: 1\n";      // 7 unknown
   const auto r = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(r, "perception.hold.enabled", "is not one of", 3)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.hold.max_age_s", "out of range", 4)) << dump(r);
@@ -400,10 +401,10 @@ TEST_P(ConfigBad, GivesTheSpecificProblem) {
 INSTANTIATE_TEST_SUITE_P(
     Kinds, ConfigBad,
     ::testing::Values(
-        BadCase{"not_yaml", "lidar: [1, 2\n", "", "not valid YAML"},
-        BadCase{"empty", "", "", "empty"},
+        BadCase{"not_yaml", "lidar: [1, 2\n", "", "not valid YAML"}, BadCase{"empty", "", "", "empty"},
         BadCase{"top_level_list", "- 1\n- 2\n", "", "expected a mapping"},
-        BadCase{"unknown_top", "lidr: {}\n", "lidr", "unknown key; known keys here: lidar, scan2d, gnss, ahrs, sync, geo, perception"},
+        BadCase{"unknown_top", "lidr: {}\n", "lidr",
+                "unknown key; known keys here: lidar, scan2d, gnss, ahrs, sync, geo, perception"},
         BadCase{"duplicate", "lidar:\n  data_port: 1\n  data_port: 2\n", "lidar.data_port", "given twice"},
         BadCase{"section_scalar", "perception: 3\n", "perception", "expected a mapping"},
         BadCase{"vec_short", "perception: {roi: {min: [1, 2]}}\n", "perception.roi.min", "list of 3 numbers"},
@@ -425,8 +426,8 @@ INSTANTIATE_TEST_SUITE_P(
                 "unknown key"},
         BadCase{"zone_edges_short", "perception: {ground: {zones: {edges_m: [2]}}}\n",
                 "perception.ground.zones.edges_m", "list of 2 to 17"},
-        BadCase{"zone_edges_scalar", "perception: {ground: {zones: {edges_m: 5}}}\n",
-                "perception.ground.zones.edges_m", "list of 2 to 17"},
+        BadCase{"zone_edges_scalar", "perception: {ground: {zones: {edges_m: 5}}}\n", "perception.ground.zones.edges_m",
+                "list of 2 to 17"},
         BadCase{"zone_sectors_zero", "perception: {ground: {zones: {sectors: [16, 0, 48, 64]}}}\n",
                 "perception.ground.zones.sectors[1]", "out of range"},
         BadCase{"zone_rings_float", "perception: {ground: {zones: {rings: [2, 4.5, 4, 4]}}}\n",
@@ -448,8 +449,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"mount_key", "lidar: {mounting: {height: 2}}\n", "lidar.mounting.height", "unknown key"},
         BadCase{"near_gap_zero", "perception: {near_field: {max_gap_m: 0}}\n", "perception.near_field.max_gap_m",
                 "out of range"},
-        BadCase{"near_points_zero", "perception: {near_field: {min_points: 0}}\n",
-                "perception.near_field.min_points", "out of range"},
+        BadCase{"near_points_zero", "perception: {near_field: {min_points: 0}}\n", "perception.near_field.min_points",
+                "out of range"},
         BadCase{"near_height_negative", "perception: {near_field: {min_height_m: -0.1}}\n",
                 "perception.near_field.min_height_m", "out of range"},
         BadCase{"near_zone_order", "perception: {near_field: {zone: {min: [12, -4, -3], max: [0.4, 4, 1]}}}\n",
@@ -486,7 +487,8 @@ TEST(ConfigLoad, DirectoryIsNotAConfig) {
 TEST(ConfigLoad, CalibrationFileRelativeToTheConfigAndCheckedAgainstTheModel) {
   const fs::path dir = fs::temp_directory_path() / "fieldguard_config_test";
   fs::create_directories(dir);
-  fs::copy_file(fs::path(FIELDGUARD_TEST_DATA) / "HDL-32.xml", dir / "HDL-32.xml", fs::copy_options::overwrite_existing);
+  fs::copy_file(fs::path(FIELDGUARD_TEST_DATA) / "HDL-32.xml", dir / "HDL-32.xml",
+                fs::copy_options::overwrite_existing);
   {
     std::ofstream(dir / "good.yaml") << "lidar: {model: auto, calibration_file: HDL-32.xml}\n";
     std::ofstream(dir / "mismatch.yaml") << "lidar: {model: VLP-16, calibration_file: HDL-32.xml}\n";
@@ -574,17 +576,17 @@ perception:
 
 TEST(ConfigLoad, ReportsBadFloatingClusterKeys) {
   const std::string text =
-      "perception:\n"                       // 1
-      "  cluster:\n"                        // 2
-      "    join_float_height_m: -0.5\n"     // 3 out of range
-      "    join_gap_m: 20\n"                // 4 out of range
-      "    join_stacked: yes please\n"      // 5 not true or false
-      "    join_stack_margin_m: -1\n"       // 6 out of range
-      "    join_fragment_gap_m: -1\n"       // 7 out of range
-      "    join_fragment_factor: 0.5\n"     // 8 out of range
-      "  filters:\n"                        // 9
-      "    float_min_height_m: 11\n"        // 10 out of range
-      "    float_min_points: 0\n";          // 11 out of range
+      "perception:\n"                    // 1
+      "  cluster:\n"                     // 2
+      "    join_float_height_m: -0.5\n"  // 3 out of range
+      "    join_gap_m: 20\n"             // 4 out of range
+      "    join_stacked: yes please\n"   // 5 not true or false
+      "    join_stack_margin_m: -1\n"    // 6 out of range
+      "    join_fragment_gap_m: -1\n"    // 7 out of range
+      "    join_fragment_factor: 0.5\n"  // 8 out of range
+      "  filters:\n"                     // 9
+      "    float_min_height_m: 11\n"     // 10 out of range
+      "    float_min_points: 0\n";       // 11 out of range
   const auto r = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_float_height_m", "out of range", 3)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.cluster.join_gap_m", "out of range", 4)) << dump(r);
@@ -617,17 +619,17 @@ TEST(ConfigLoad, ReadsTheHeightGrowthKeys) {
 
 TEST(ConfigLoad, ReportsBadHeightGrowthKeys) {
   const std::string text =
-      "perception:\n"                         // 1
-      "  filters:\n"                          // 2
-      "    min_height_growth_from_m: -5\n"    // 3 out of range
-      "    min_height_growth_per_m: 2\n";     // 4 out of range
+      "perception:\n"                       // 1
+      "  filters:\n"                        // 2
+      "    min_height_growth_from_m: -5\n"  // 3 out of range
+      "    min_height_growth_per_m: 2\n";   // 4 out of range
   const auto r = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(r, "perception.filters.min_height_growth_from_m", "out of range", 3)) << dump(r);
   EXPECT_TRUE(has_issue(r, "perception.filters.min_height_growth_per_m", "out of range", 4)) << dump(r);
   EXPECT_EQ(r.issues.size(), 2U) << dump(r);
   // A cap under min_height_m would lower the threshold far out.
-  const auto c = load_config_text(
-      "perception:\n  filters:\n    min_height_m: 0.5\n    min_height_growth_max_m: 0.3\n", "bad.yaml");
+  const auto c = load_config_text("perception:\n  filters:\n    min_height_m: 0.5\n    min_height_growth_max_m: 0.3\n",
+                                  "bad.yaml");
   EXPECT_TRUE(has_issue(c, "perception.filters.min_height_growth_max_m", "must not be less than min_height_m", 4))
       << dump(c);
   EXPECT_EQ(c.issues.size(), 1U) << dump(c);
@@ -661,7 +663,8 @@ TEST(ConfigLoad, ReportsABadGroundMaxBelow) {
     const std::string text = std::string("perception:\n  ground:\n    zones:\n      max_below_m: ") + bad + "\n";
     const auto r = load_config_text(text, "bad.yaml");
     EXPECT_FALSE(r.ok()) << bad;
-    EXPECT_TRUE(has_issue(r, "perception.ground.zones.max_below_m", std::string(bad) == "deep" ? "expected a number" : "out of range", 4))
+    EXPECT_TRUE(has_issue(r, "perception.ground.zones.max_below_m",
+                          std::string(bad) == "deep" ? "expected a number" : "out of range", 4))
         << bad << ": " << dump(r);
     EXPECT_EQ(r.issues.size(), 1U) << dump(r);
   }
@@ -688,13 +691,13 @@ perception:
   EXPECT_EQ(d.config.perception.cluster.split_min_length_m, 2.0);  // left out: fieldguard.yaml's value
 
   const std::string text =
-      "perception:\n"                         // 1
-      "  cluster:\n"                          // 2
-      "    split_min_length_m: -1\n"          // 3 out of range
-      "    split_min_part_m: 200\n"           // 4 out of range
-      "    split_gap_ratio: .nan\n"           // 5 not a number
-      "    split_min_part_points: -3\n"       // 6 out of range
-      "    split_full_range_m: 0\n";          // 7 out of range: the scale divides by it
+      "perception:\n"                    // 1
+      "  cluster:\n"                     // 2
+      "    split_min_length_m: -1\n"     // 3 out of range
+      "    split_min_part_m: 200\n"      // 4 out of range
+      "    split_gap_ratio: .nan\n"      // 5 not a number
+      "    split_min_part_points: -3\n"  // 6 out of range
+      "    split_full_range_m: 0\n";     // 7 out of range: the scale divides by it
   const auto bad = load_config_text(text, "bad.yaml");
   EXPECT_TRUE(has_issue(bad, "perception.cluster.split_min_length_m", "out of range", 3)) << dump(bad);
   EXPECT_TRUE(has_issue(bad, "perception.cluster.split_min_part_m", "out of range", 4)) << dump(bad);

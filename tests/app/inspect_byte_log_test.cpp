@@ -26,7 +26,9 @@ std::string read_file(const std::string& path) {
   return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
 }
 
-ByteSpan span_of(const std::string& s) { return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()}; }  // NOLINT
+ByteSpan span_of(const std::string& s) {
+  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
+}  // NOLINT
 
 // The bytes as a serial reader delivers them: records of uneven size (1..97 bytes) that cut sentences and
 // frames anywhere, 5 ms apart, with a command to the sensor now and then.
@@ -78,8 +80,7 @@ TEST(InspectByteLog, GnssLogDecodesLikeTheRawNmea) {
 }
 
 TEST(InspectByteLog, AhrsLogDecodesLikeTheRawXsensStream) {
-  expect_same_samples(std::string(FIELDGUARD_TEST_DATA) + "/xsens/einride_1.bin", "ahrs /dev/ttyUSB1 921600",
-                      "xsens");
+  expect_same_samples(std::string(FIELDGUARD_TEST_DATA) + "/xsens/einride_1.bin", "ahrs /dev/ttyUSB1 921600", "xsens");
 }
 
 TEST(InspectByteLog, CorruptRecordStopsReadingWithANote) {
@@ -90,7 +91,8 @@ TEST(InspectByteLog, CorruptRecordStopsReadingWithANote) {
   std::size_t at = log.find('\n', log.find('\n') + 1) + 1;  // past the magic line and the source line
   for (int r = 0; r < 2; ++r) {
     std::uint32_t len = 0;
-    for (int b = 3; b >= 0; --b) len = (len << 8U) | static_cast<std::uint8_t>(log[at + 8 + static_cast<std::size_t>(b)]);
+    for (int b = 3; b >= 0; --b)
+      len = (len << 8U) | static_cast<std::uint8_t>(log[at + 8 + static_cast<std::size_t>(b)]);
     at += 13 + len;
   }
   ASSERT_LT(at + 12, log.size());

@@ -54,7 +54,7 @@ TEST(InspectCandump, RealJ1939TruckLog) {
       EXPECT_EQ(f.at("pgn").get<long long>(), 61444);  // 0xF004
       EXPECT_EQ(f.at("sa").get<long long>(), 0x00);
       EXPECT_EQ(f.at("priority").get<long long>(), 3);
-      EXPECT_FALSE(f.contains("da"));              // PDU2: PF 0xF0 >= 240
+      EXPECT_FALSE(f.contains("da"));                          // PDU2: PF 0xF0 >= 240
     } else if (f.at("id").get<std::string>() == "0CFEF100") {  // CCVS1 at priority 3
       ++ccvs1;
       EXPECT_EQ(f.at("pgn").get<long long>(), 65265);  // 0xFEF1

@@ -142,9 +142,9 @@ TEST(InspectCli, NmeaRecordsCarryTheDocumentedKeys) {
 
 TEST(InspectCli, XsensRecordsCarryTheDocumentedKeys) {
   // protocols.md §5.4: counter 42581, STF 5719854, roll 1.5, pitch -2.25, yaw 90, status 0x00400003; noise first.
-  const std::string frame = bytes({0xFA, 0xFF, 0x36, 0x22, 0x10, 0x20, 0x02, 0xA6, 0x55, 0x10, 0x60, 0x04, 0x00, 0x57,
-                                   0x47, 0x2E, 0x20, 0x30, 0x0C, 0x3F, 0xC0, 0x00, 0x00, 0xC0, 0x10, 0x00, 0x00, 0x42,
-                                   0xB4, 0x00, 0x00, 0xE0, 0x20, 0x04, 0x00, 0x40, 0x00, 0x03, 0xD4});
+  const std::string frame = bytes({0xFA, 0xFF, 0x36, 0x22, 0x10, 0x20, 0x02, 0xA6, 0x55, 0x10, 0x60, 0x04, 0x00,
+                                   0x57, 0x47, 0x2E, 0x20, 0x30, 0x0C, 0x3F, 0xC0, 0x00, 0x00, 0xC0, 0x10, 0x00,
+                                   0x00, 0x42, 0xB4, 0x00, 0x00, 0xE0, 0x20, 0x04, 0x00, 0x40, 0x00, 0x03, 0xD4});
   const std::string ack = bytes({0xFA, 0xFF, 0x31, 0x00, 0xD0});
   const TempFile f("keys.xbus", bytes({0x00, 0x13, 0xFA}) + frame + ack);
   const auto run = run_fieldguard("inspect " + f.arg());
@@ -177,8 +177,10 @@ TEST(InspectCli, FormatGivenExplicitlyOverridesTheGuess) {
 
 TEST(InspectCli, PipesAndCapturesThatStartMidSentence) {
   // A capture cut in the middle of a sentence, with a UTF-8 BOM: still recognised as NMEA.
-  const std::string text = "\xEF\xBB\xBF" "45.4,M,46.9,M,,*47\r\n$GNHDT,271.45,T*1E\r\n$GNTHS,271.45,A*1C\r\n"
-                           "$GNVTG,87.3,T,,M,0.52,N,0.96,K,R*34\r\n";
+  const std::string text =
+      "\xEF\xBB\xBF"
+      "45.4,M,46.9,M,,*47\r\n$GNHDT,271.45,T*1E\r\n$GNTHS,271.45,A*1C\r\n"
+      "$GNVTG,87.3,T,,M,0.52,N,0.96,K,R*34\r\n";
   const TempFile f("midsentence", text);
   const auto run = run_fieldguard("inspect " + f.arg());
   EXPECT_EQ(run.exit_code, 0) << run.output;

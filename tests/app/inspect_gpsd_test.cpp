@@ -119,7 +119,8 @@ void compare_with_gpsd(const std::string& log, const std::vector<Json>& records,
 
     // Time (and for RMC the date) against the TPV time.
     ASSERT_FALSE(r.at("time_utc").is_null()) << where;
-    EXPECT_NEAR(seconds_of_day(r.at("time_utc").get<std::string>()), seconds_of_day(e.time.substr(11, 12)), 5e-4) << where;
+    EXPECT_NEAR(seconds_of_day(r.at("time_utc").get<std::string>()), seconds_of_day(e.time.substr(11, 12)), 5e-4)
+        << where;
     if (e.kind == "RMC") {
       EXPECT_EQ(r.at("date").get<std::string>(), e.time.substr(0, 10)) << where;
     }
@@ -135,11 +136,12 @@ void compare_with_gpsd(const std::string& log, const std::vector<Json>& records,
     ++result.gga;
 
     const int status = gpsd_status(r.at("quality"));
-    EXPECT_EQ(status >= 2 ? std::to_string(status) : std::string("-"), e.status) << where << " quality "
-                                                                                    << testing::text(r.at("quality"));
+    EXPECT_EQ(status >= 2 ? std::to_string(status) : std::string("-"), e.status)
+        << where << " quality " << testing::text(r.at("quality"));
     if (e.mode >= 2) {
       EXPECT_TRUE(r.at("lat_deg").is_number()) << where << ": gpsd has a fix, the GGA no position";
-      EXPECT_GE(r.at("quality").is_number() ? r.at("quality").get<double>() : 0.0, 1.0) << where << ": gpsd has a fix, the GGA quality is 0";
+      EXPECT_GE(r.at("quality").is_number() ? r.at("quality").get<double>() : 0.0, 1.0)
+          << where << ": gpsd has a fix, the GGA quality is 0";
     }
     if (e.alt_msl != "-") {
       ASSERT_TRUE(r.at("alt_m").is_number()) << where;
@@ -190,9 +192,10 @@ TEST_P(GpsdLog, DecodesLikeGpsd) {
   LogResult r;
   compare_with_gpsd(log, records, r);
   EXPECT_GT(r.compared, 0U);
-  std::printf("[ gpsd     ] %-24s sentences %4zu: accepted %3zu, unsupported type %3zu, other rejections 0; "
-              "compared with gpsd: %3zu GGA + %3zu RMC; max |dlat|,|dlon| %.3g deg\n",
-              log.c_str(), all, records.size(), all - ours, r.gga, r.compared - r.gga, r.max_pos_diff);
+  std::printf(
+      "[ gpsd     ] %-24s sentences %4zu: accepted %3zu, unsupported type %3zu, other rejections 0; "
+      "compared with gpsd: %3zu GGA + %3zu RMC; max |dlat|,|dlon| %.3g deg\n",
+      log.c_str(), all, records.size(), all - ours, r.gga, r.compared - r.gga, r.max_pos_diff);
 }
 
 TEST_P(GpsdLog, CorruptedSentencesAreRejectedAndCounted) {

@@ -120,7 +120,8 @@ void expect_session(const std::string& output, bool with_times) {
   EXPECT_EQ(bad, 0U);
   ASSERT_EQ(r.size(), 9U) << output;
   std::vector<std::string> types;
-  for (const auto& rec : r) types.push_back(rec.at("type").get<std::string>() + ":" + rec.at("command").get<std::string>());
+  for (const auto& rec : r)
+    types.push_back(rec.at("type").get<std::string>() + ":" + rec.at("command").get<std::string>());
   EXPECT_EQ(types, (std::vector<std::string>{"scip_status:SCIP2.0", "scip_info:VV", "scip_info:PP", "scip_info:II",
                                              "scip_status:BM", "scip_scan:MD", "scip_scan:MD", "scip_scan:MD",
                                              "scip_scan:GD"}));

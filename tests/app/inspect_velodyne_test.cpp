@@ -54,8 +54,9 @@ Bytes udp_frame(std::uint16_t port, const Bytes& payload) {
 std::string arg(const std::string& path) { return "'" + path + "'"; }
 
 long long total_points(const std::vector<Json>& records) {
-  return std::accumulate(records.begin(), records.end(), 0LL,
-                         [](long long s, const Json& r) { return s + (r.contains("points") ? r.at("points").get<long long>() : 0); });
+  return std::accumulate(records.begin(), records.end(), 0LL, [](long long s, const Json& r) {
+    return s + (r.contains("points") ? r.at("points").get<long long>() : 0);
+  });
 }
 
 TEST(InspectVelodyne, Hdl32eMontereyDataAndPositionRecords) {

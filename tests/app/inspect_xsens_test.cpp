@@ -61,7 +61,8 @@ std::vector<Golden> parse_golden(const std::string& text) {
     if (line.empty()) {
       if (!out.back().empty()) out.emplace_back();
     } else if (line.rfind("  ", 0) == 0) {
-      if (!out.back().empty()) out.back().back().second.push_back(golden_value(out.back().back().first, line.substr(2)));
+      if (!out.back().empty())
+        out.back().back().second.push_back(golden_value(out.back().back().first, line.substr(2)));
     } else {
       out.back().emplace_back(line.substr(0, line.size() - 1), std::vector<std::string>{});
     }
@@ -93,25 +94,58 @@ std::vector<double> numbers(const std::vector<std::string>& v) {
   return out;
 }
 
-const std::map<std::string, std::string> kVectors = {
-    {"Acceleration", "acc"},       {"DeltaV", "delta_v"},         {"RateOfTurn", "gyr"},
-    {"DeltaQ", "delta_q"},         {"EulerAngles", "euler_deg"},  {"Quaternion", "quat"},
-    {"FreeAcceleration", "free_acc"}, {"MagneticField", "mag"},   {"VelocityXYZ", "vel_mps"},
-    {"PositionECEF", "position_ecef_m"}, {"RotationMatrix", "rotation_matrix"}};
-const std::map<std::string, std::string> kFrameKeys = {
-    {"EulerAngles", "euler_frame"}, {"Quaternion", "quat_frame"}, {"VelocityXYZ", "vel_frame"},
-    {"RotationMatrix", "rotation_matrix_frame"}};
-const std::map<std::string, std::string> kFrames = {{"EastNorthUp", "ENU"}, {"NorthEastDown", "NED"},
-                                                    {"NorthWestUp", "NWU"}};
-const std::map<std::string, std::string> kPvt = {
-    {"ITOW", "itow_ms"}, {"Year", "year"}, {"Month", "month"}, {"Day", "day"}, {"Hour", "hour"}, {"Min", "min"},
-    {"Sec", "sec"}, {"Valid", "valid"}, {"TAcc", "t_acc_ns"}, {"Nano", "nano_ns"}, {"FixType", "fix_type"},
-    {"Flags", "flags"}, {"NumSV", "num_sv"}, {"Reserved1", "reserved1"}, {"Lon", "lon_1e7deg"},
-    {"Lat", "lat_1e7deg"}, {"Height", "height_mm"}, {"HMSL", "hmsl_mm"}, {"HAcc", "h_acc_mm"},
-    {"VAcc", "v_acc_mm"}, {"VelN", "vel_n_mmps"}, {"VelE", "vel_e_mmps"}, {"VelD", "vel_d_mmps"},
-    {"GSpeed", "gspeed_mmps"}, {"HeadMot", "head_mot_1e5deg"}, {"SAcc", "s_acc_mmps"},
-    {"HeadAcc", "head_acc_1e5deg"}, {"HeadVeh", "head_veh_1e5deg"}, {"GDOP", "gdop"}, {"PDOP", "pdop"},
-    {"TDOP", "tdop"}, {"VDOP", "vdop"}, {"HDOP", "hdop"}, {"NDOP", "ndop"}, {"EDOP", "edop"}};
+const std::map<std::string, std::string> kVectors = {{"Acceleration", "acc"},
+                                                     {"DeltaV", "delta_v"},
+                                                     {"RateOfTurn", "gyr"},
+                                                     {"DeltaQ", "delta_q"},
+                                                     {"EulerAngles", "euler_deg"},
+                                                     {"Quaternion", "quat"},
+                                                     {"FreeAcceleration", "free_acc"},
+                                                     {"MagneticField", "mag"},
+                                                     {"VelocityXYZ", "vel_mps"},
+                                                     {"PositionECEF", "position_ecef_m"},
+                                                     {"RotationMatrix", "rotation_matrix"}};
+const std::map<std::string, std::string> kFrameKeys = {{"EulerAngles", "euler_frame"},
+                                                       {"Quaternion", "quat_frame"},
+                                                       {"VelocityXYZ", "vel_frame"},
+                                                       {"RotationMatrix", "rotation_matrix_frame"}};
+const std::map<std::string, std::string> kFrames = {
+    {"EastNorthUp", "ENU"}, {"NorthEastDown", "NED"}, {"NorthWestUp", "NWU"}};
+const std::map<std::string, std::string> kPvt = {{"ITOW", "itow_ms"},
+                                                 {"Year", "year"},
+                                                 {"Month", "month"},
+                                                 {"Day", "day"},
+                                                 {"Hour", "hour"},
+                                                 {"Min", "min"},
+                                                 {"Sec", "sec"},
+                                                 {"Valid", "valid"},
+                                                 {"TAcc", "t_acc_ns"},
+                                                 {"Nano", "nano_ns"},
+                                                 {"FixType", "fix_type"},
+                                                 {"Flags", "flags"},
+                                                 {"NumSV", "num_sv"},
+                                                 {"Reserved1", "reserved1"},
+                                                 {"Lon", "lon_1e7deg"},
+                                                 {"Lat", "lat_1e7deg"},
+                                                 {"Height", "height_mm"},
+                                                 {"HMSL", "hmsl_mm"},
+                                                 {"HAcc", "h_acc_mm"},
+                                                 {"VAcc", "v_acc_mm"},
+                                                 {"VelN", "vel_n_mmps"},
+                                                 {"VelE", "vel_e_mmps"},
+                                                 {"VelD", "vel_d_mmps"},
+                                                 {"GSpeed", "gspeed_mmps"},
+                                                 {"HeadMot", "head_mot_1e5deg"},
+                                                 {"SAcc", "s_acc_mmps"},
+                                                 {"HeadAcc", "head_acc_1e5deg"},
+                                                 {"HeadVeh", "head_veh_1e5deg"},
+                                                 {"GDOP", "gdop"},
+                                                 {"PDOP", "pdop"},
+                                                 {"TDOP", "tdop"},
+                                                 {"VDOP", "vdop"},
+                                                 {"HDOP", "hdop"},
+                                                 {"NDOP", "ndop"},
+                                                 {"EDOP", "edop"}};
 
 // Compares one record with its golden decode; adds the number of golden fields compared to `fields`.
 void compare(const Golden& g, const Json& r, const std::string& where, std::size_t& fields) {

@@ -3,9 +3,8 @@
 // nlohmann/json. Look members up with .at(): a missing key throws, which gtest reports as the test's failure
 // (const operator[] on a missing key is undefined behaviour in nlohmann/json).
 
-#include <nlohmann/json.hpp>
-
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>

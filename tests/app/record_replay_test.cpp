@@ -59,9 +59,11 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   Child scip({FIELDGUARD_SCIP_EMULATOR, "--scene", "obstacle"});
   const std::string scip_port = scip.line();
   ASSERT_FALSE(scip_port.empty());
-  Child gnss({FIELDGUARD_SERIAL_EMULATOR, "--file", data + "/nmea/nmea-rtk.log", "--baud", "115200", "--hold-open", "30"});
+  Child gnss(
+      {FIELDGUARD_SERIAL_EMULATOR, "--file", data + "/nmea/nmea-rtk.log", "--baud", "115200", "--hold-open", "30"});
   const std::string gnss_dev = gnss.line();
-  Child ahrs({FIELDGUARD_SERIAL_EMULATOR, "--file", data + "/xsens/einride_1.bin", "--baud", "921600", "--hold-open", "30"});
+  Child ahrs(
+      {FIELDGUARD_SERIAL_EMULATOR, "--file", data + "/xsens/einride_1.bin", "--baud", "921600", "--hold-open", "30"});
   const std::string ahrs_dev = ahrs.line();
   ASSERT_FALSE(gnss_dev.empty());
   ASSERT_FALSE(ahrs_dev.empty());
@@ -69,13 +71,15 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   const std::uint16_t data_port = free_udp_port();
   const std::uint16_t position_port = free_udp_port();
   const std::string config = (dir.path() / "live.yaml").string();
-  std::ofstream(config) << "lidar: {model: auto, data_port: " << data_port << ", position_port: " << position_port << "}\n"
+  std::ofstream(config) << "lidar: {model: auto, data_port: " << data_port << ", position_port: " << position_port
+                        << "}\n"
                         << "scan2d: {enabled: true, host: 127.0.0.1, port: " << scip_port << "}\n"
                         << "gnss: {enabled: true, device: " << gnss_dev << ", baud: 115200}\n"
                         << "ahrs: {enabled: true, device: " << ahrs_dev << ", baud: 921600}\n";
   const std::string session = (dir.path() / "session").string();
   const std::string live = (dir.path() / "live.jsonl").string();
-  Child record({FIELDGUARD_BINARY, "record", "--config", config, "--out", session, "--duration", "3", "--samples-out", live});
+  Child record(
+      {FIELDGUARD_BINARY, "record", "--config", config, "--out", session, "--duration", "3", "--samples-out", live});
   std::this_thread::sleep_for(500ms);  // let it bind its ports
 
   // The real HDL-32E capture, sent to the recorder at the sensor's packet rate.
@@ -88,7 +92,8 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
     to.sin_family = AF_INET;
     to.sin_port = htons(d->dst_port == 2368 ? data_port : position_port);
     to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    sent += ::sendto(tx, d->payload.data(), d->payload.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) > 0 ? 1U : 0U;
+    sent += ::sendto(tx, d->payload.data(), d->payload.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) > 0 ? 1U
+                                                                                                                   : 0U;
     std::this_thread::sleep_for(550us);
   }
   ::close(tx);
@@ -96,7 +101,8 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   ASSERT_EQ(record.wait(), 0);
 
   const std::string replayed = (dir.path() / "replay.jsonl").string();
-  auto r = testing::run_fieldguard("replay --config '" + config + "' --session '" + session + "' --samples-out '" + replayed + "'");
+  auto r = testing::run_fieldguard("replay --config '" + config + "' --session '" + session + "' --samples-out '" +
+                                   replayed + "'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
   const auto a = by_sensor(live);
@@ -110,15 +116,16 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   std::printf("live samples: lidar %zu, lidar_position %zu, scan2d %zu, gnss %zu, ahrs %zu\n", a.at("lidar").size(),
               a.at("lidar_position").size(), a.at("scan2d").size(), a.at("gnss").size(), a.at("ahrs").size());
   EXPECT_EQ(a.at("lidar_position").size(), 60U);
-  EXPECT_EQ(a.at("gnss").size(), 244U);  // every sentence of the log (122 GGA + 122 RMC)
-  EXPECT_EQ(a.at("ahrs").size(), 100U);  // every message of the einride stream
+  EXPECT_EQ(a.at("gnss").size(), 244U);   // every sentence of the log (122 GGA + 122 RMC)
+  EXPECT_EQ(a.at("ahrs").size(), 100U);   // every message of the einride stream
   EXPECT_GT(a.at("scan2d").size(), 60U);  // 40 Hz for about 2.5 s
 
   // The same recording given file by file.
   const std::string one_by_one = (dir.path() / "files.jsonl").string();
-  auto f = testing::run_fieldguard("replay --config '" + config + "' --pcap '" + session + "/lidar.pcap' --scan2d-log '" +
-                                   session + "/scan2d.log' --gnss-log '" + session + "/gnss.log' --ahrs-log '" + session +
-                                   "/ahrs.log' --samples-out '" + one_by_one + "'");
+  auto f =
+      testing::run_fieldguard("replay --config '" + config + "' --pcap '" + session + "/lidar.pcap' --scan2d-log '" +
+                              session + "/scan2d.log' --gnss-log '" + session + "/gnss.log' --ahrs-log '" + session +
+                              "/ahrs.log' --samples-out '" + one_by_one + "'");
   ASSERT_EQ(f.exit_code, 0) << f.output;
   EXPECT_EQ(by_sensor(one_by_one), b);
 }

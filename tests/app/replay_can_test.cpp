@@ -185,7 +185,8 @@ void check_can_log(const std::string& config, const std::string& pcap, const std
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const std::string asc_text = slurp(asc);
   std::size_t asc_frames = 0;
-  for (std::size_t at = asc_text.find(" Rx "); at != std::string::npos; at = asc_text.find(" Rx ", at + 1)) ++asc_frames;
+  for (std::size_t at = asc_text.find(" Rx "); at != std::string::npos; at = asc_text.find(" Rx ", at + 1))
+    ++asc_frames;
   EXPECT_EQ(asc_frames, count_lines(text)) << asc_text.substr(0, 2000);
 
   const auto db = test::dbc::parse_file(kSource + "/config/fieldguard.dbc");
@@ -261,8 +262,8 @@ void check_can_log(const std::string& config, const std::string& pcap, const std
       const auto hi = o.at("max").get<std::vector<double>>();
       // Inside: overlapping the zone by more than 0.3 m and seen; far: 1.5 m clear of it.
       const double m = e.inside_margin;
-      const bool inside = lo[0] < zx1 - m && hi[0] > zx0 + m && lo[1] < zy - m && hi[1] > -zy + m &&
-                          o.at("hits").get<double>() >= 5;
+      const bool inside =
+          lo[0] < zx1 - m && hi[0] > zx0 + m && lo[1] < zy - m && hi[1] > -zy + m && o.at("hits").get<double>() >= 5;
       const double f = e.far_margin;
       const bool far = lo[0] > zx1 + f || hi[0] < zx0 - f || lo[1] > zy + f || hi[1] < -zy - f;
       w = inside ? Where::Inside : (far ? Where::Far : Where::Between);
@@ -300,7 +301,8 @@ void check_can_log(const std::string& config, const std::string& pcap, const std
   int entries = 0;
   for (int k = 1; k < kRotations; ++k) {
     if (by_frame.at(k - 1).command == 0 && by_frame.at(k).command == 1) {
-      EXPECT_EQ(where[static_cast<std::size_t>(k)], Where::Inside) << "rotation " << k << " stops, but not for the pedestrian";
+      EXPECT_EQ(where[static_cast<std::size_t>(k)], Where::Inside)
+          << "rotation " << k << " stops, but not for the pedestrian";
       ++entries;
     }
   }
@@ -311,7 +313,9 @@ void check_can_log(const std::string& config, const std::string& pcap, const std
   long long stops = 0;
   long long gos = 0;
   long long changes = 0;
-  ASSERT_EQ(std::sscanf(r.output.c_str() + pos, "stop decisions %lld stop, %lld go, %lld changes", &stops, &gos, &changes), 3);
+  ASSERT_EQ(
+      std::sscanf(r.output.c_str() + pos, "stop decisions %lld stop, %lld go, %lld changes", &stops, &gos, &changes),
+      3);
   EXPECT_EQ(stops + gos, kRotations);
   long long stop_frames = 0;
   for (const auto& [k, s] : by_frame) stop_frames += s.command == 1 ? 1 : 0;

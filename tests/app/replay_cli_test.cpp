@@ -101,7 +101,7 @@ TEST(Replay, MissingFile) {
 TEST(Replay, NotAPcap) {
   testing::TempDir dir;
   const auto path = dir.write("notes.pcap", Bytes{'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd', '\n',
-                                                   'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd', '\n'});
+                                                  'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd', '\n'});
   auto r = run_fieldguard(replay(path));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("not a pcap"), std::string::npos) << r.output;
@@ -122,7 +122,8 @@ TEST(Replay, TruncatedFileKeepsEverythingBeforeTheCut) {
   std::size_t last = off;
   while (off + 16 <= bytes.size()) {
     last = off;
-    const std::size_t caplen = bytes[off + 8] | (std::size_t{bytes[off + 9]} << 8) | (std::size_t{bytes[off + 10]} << 16);
+    const std::size_t caplen =
+        bytes[off + 8] | (std::size_t{bytes[off + 9]} << 8) | (std::size_t{bytes[off + 10]} << 16);
     off += 16 + caplen;
   }
   ASSERT_EQ(off, bytes.size());
@@ -152,11 +153,11 @@ TEST(Replay, BadLengthsOtherPortsAndGoodPacketsMixed) {
   std::int64_t t = 1'700'000'000'000'000'000;
   for (const auto& p : good) pcap.add(frame_for(p, 2368), t += 552'960);
   Bytes short_payload(good[0].begin(), good[0].begin() + 1000);
-  pcap.add(frame_for(short_payload, 2368), t += 1000);       // wrong length on the data port
+  pcap.add(frame_for(short_payload, 2368), t += 1000);         // wrong length on the data port
   pcap.add(frame_for(testing::pattern(64), 9999), t += 1000);  // another port
   testing::Ipv4Udp frag;
   frag.payload = good[0];
-  frag.flags_fragment = 0x2000;                                // more fragments
+  frag.flags_fragment = 0x2000;  // more fragments
   pcap.add(testing::ethernet(testing::build(frag)), t += 1000);
   testing::TempDir dir;
   auto r = run_fieldguard(replay(dir.write("mixed.pcap", pcap.bytes())));

@@ -5,11 +5,9 @@
 // Measured and printed: the height spread of the ground points with and without compensation, the pole's
 // plane coordinates over 100 frames, and the box found from the 2D scan and not without it.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <Eigen/Core>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -24,21 +22,21 @@
 #include <string>
 #include <vector>
 
-#include "fieldguard/engine/fusion.hpp"
-#include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "app/json_reader.hpp"
-#include "replay/recording.hpp"
 #include "app/run_command.hpp"
 #include "app/sim_can_support.hpp"
-#include "support/shared_output.hpp"
 #include "fieldguard/config/config.hpp"
-#include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/drivers/velodyne_decoder.hpp"
+#include "fieldguard/engine/fusion.hpp"
+#include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/geo/projection.hpp"
 #include "fieldguard/io/byte_log.hpp"
 #include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "output/dbc_reader.hpp"
+#include "replay/recording.hpp"
+#include "support/shared_output.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -68,7 +66,8 @@ class ReplayFusion : public ::testing::Test {
     fs::create_directories(*dir_);
     // One session per build, shared by this suite's test processes (making it takes 20 s under ASan).
     session_dir_ = new std::string(testing::shared_output(
-        FIELDGUARD_TEST_WORK, "uneven-drive-" + std::to_string(kRotations) + "-seed1-" + testing::stamp_of(FIELDGUARD_SIM),
+        FIELDGUARD_TEST_WORK,
+        "uneven-drive-" + std::to_string(kRotations) + "-seed1-" + testing::stamp_of(FIELDGUARD_SIM),
         [](const std::string& d) {
           const std::string cmd = std::string("'") + FIELDGUARD_SIM + "' --scene uneven-drive --session '" + d +
                                   "' --rotations " + std::to_string(kRotations) + " --seed 1 --quiet 2>&1";
@@ -107,7 +106,9 @@ class ReplayFusion : public ::testing::Test {
   }
   static std::string session(const std::string& name) { return (fs::path(*session_dir_) / name).string(); }
   static std::vector<LogFile> all_logs() {
-    return {{session("scan2d.log"), LogKind::Scan2d}, {session("gnss.log"), LogKind::Gnss}, {session("ahrs.log"), LogKind::Ahrs}};
+    return {{session("scan2d.log"), LogKind::Scan2d},
+            {session("gnss.log"), LogKind::Gnss},
+            {session("ahrs.log"), LogKind::Ahrs}};
   }
   // Every fused frame of the session, in order.
   static std::vector<FrameJob> fused_frames(const std::vector<LogFile>& logs) {
@@ -120,7 +121,8 @@ class ReplayFusion : public ::testing::Test {
     while (auto ev = rec->next()) {
       last = ev->time;
       if (ev->datagram != nullptr) {
-        if (ev->datagram->dst_port == config_->lidar.data_port && ev->datagram->payload.size() == velodyne::kDataPacketSize) {
+        if (ev->datagram->dst_port == config_->lidar.data_port &&
+            ev->datagram->payload.size() == velodyne::kDataPacketSize) {
           fusion.lidar(ev->datagram->payload, ev->time, jobs);
         }
       } else if (ev->kind == LogKind::Scan2d) {
@@ -167,7 +169,8 @@ TEST_F(ReplayFusion, EveryFrameIsCompleteAndLevelledFromItsOwnSamples) {
     ASSERT_TRUE(d.fusion.has_value());
     if (d.fusion->levelling == geo::Levelling::Full) ++full;
   }
-  std::printf("fused frames: %zu, %zu levelled with attitude and position, %zu timed out\n", jobs.size(), full, timed_out);
+  std::printf("fused frames: %zu, %zu levelled with attitude and position, %zu timed out\n", jobs.size(), full,
+              timed_out);
   // The first and the last windows may lack the GNSS fix after them; every other is whole.
   EXPECT_LE(timed_out, 2U);
   EXPECT_GE(full, jobs.size() - 2);
@@ -179,7 +182,8 @@ Eigen::Vector3d uncompensated(const LidarPoint& p, const geo::CompensatedFrame& 
   const double yaw = f.attitude->yaw_deg * std::numbers::pi / 180.0;
   const double x = static_cast<double>(p.x) + lidar.x_m;
   const double y = static_cast<double>(p.y) + lidar.y_m;
-  return f.reference->enu() + Eigen::Vector3d(std::cos(yaw) * x - std::sin(yaw) * y, std::sin(yaw) * x + std::cos(yaw) * y,
+  return f.reference->enu() + Eigen::Vector3d(std::cos(yaw) * x - std::sin(yaw) * y,
+                                              std::sin(yaw) * x + std::cos(yaw) * y,
                                               static_cast<double>(p.z) + lidar.z_m);
 }
 
@@ -258,12 +262,14 @@ TEST_F(ReplayFusion, GroundHeightSpreadIsAtLeastThreeTimesSmallerCompensated) {
   const auto [fixed_sd, fixed_n] = fixed.sd();
   ASSERT_GT(raw_n, 5000U);
   ASSERT_GT(fixed_n, 5000U);
-  std::printf("ground height at the same place across %zu frames (0.5 m cells, rings 0-11): uncompensated %.3f m "
-              "(%zu cell-frames), compensated %.3f m (%zu): %.1fx smaller\n",
-              jobs.size(), raw_sd, raw_n, fixed_sd, fixed_n, raw_sd / fixed_sd);
-  std::printf("(all those ground points' heights pooled, the field's own swells included: sensor frame %.3f m, "
-              "detection frame %.3f m)\n",
-              sd(raw_z), sd(comp_z));
+  std::printf(
+      "ground height at the same place across %zu frames (0.5 m cells, rings 0-11): uncompensated %.3f m "
+      "(%zu cell-frames), compensated %.3f m (%zu): %.1fx smaller\n",
+      jobs.size(), raw_sd, raw_n, fixed_sd, fixed_n, raw_sd / fixed_sd);
+  std::printf(
+      "(all those ground points' heights pooled, the field's own swells included: sensor frame %.3f m, "
+      "detection frame %.3f m)\n",
+      sd(raw_z), sd(comp_z));
   EXPECT_GE(raw_sd / fixed_sd, 3.0);
   // The compensated spread is what the range noise (1.5 cm), the AHRS noise and the GNSS noise leave.
   EXPECT_LT(fixed_sd, 0.05);
@@ -335,16 +341,18 @@ TEST_F(ReplayFusion, FixedPoleStaysWithin5cmOnThePlaneOver100Frames) {
   }
   ASSERT_GE(rms_fixed.size(), 100U) << "frames that see the pole";
   const double worst = *std::max_element(rms_fixed.begin(), rms_fixed.end());
-  const double mean_rms = std::accumulate(rms_fixed.begin(), rms_fixed.end(), 0.0) / static_cast<double>(rms_fixed.size());
+  const double mean_rms =
+      std::accumulate(rms_fixed.begin(), rms_fixed.end(), 0.0) / static_cast<double>(rms_fixed.size());
   const double worst_raw = rms_raw.empty() ? 0.0 : *std::max_element(rms_raw.begin(), rms_raw.end());
   const double me = std::accumulate(east.begin(), east.end(), 0.0) / static_cast<double>(east.size());
   const double mn = std::accumulate(north.begin(), north.end(), 0.0) / static_cast<double>(north.size());
   double spread = 0.0;
   for (std::size_t i = 0; i < east.size(); ++i) spread = std::max(spread, std::hypot(east[i] - me, north[i] - mn));
-  std::printf("pole over %zu frames: its points' RMS distance from the true pole surface %.3f m on average, %.3f m in "
-              "the worst frame (uncompensated: worst %.3f m); the visible faces' centroid stays within %.3f m of its "
-              "mean (the faces seen change as the tractor passes: up to 0.1 m)\n",
-              rms_fixed.size(), mean_rms, worst, worst_raw, spread);
+  std::printf(
+      "pole over %zu frames: its points' RMS distance from the true pole surface %.3f m on average, %.3f m in "
+      "the worst frame (uncompensated: worst %.3f m); the visible faces' centroid stays within %.3f m of its "
+      "mean (the faces seen change as the tractor passes: up to 0.1 m)\n",
+      rms_fixed.size(), mean_rms, worst, worst_raw, spread);
   EXPECT_LE(worst, 0.05);
   EXPECT_GT(worst_raw, 3.0 * worst);
 }
@@ -381,7 +389,8 @@ StopLog replay_stops(const std::string& session_dir, const std::string& work) {
 TEST_F(ReplayFusion, AGnssPositionJumpStopsTheTractorAsASensorFault) {
   const fs::path bad = *dir_ / "jump";
   fs::create_directories(bad);
-  for (const char* f : {"lidar.pcap", "scan2d.log", "ahrs.log"}) fs::copy_file(session(f), bad / f, fs::copy_options::overwrite_existing);
+  for (const char* f : {"lidar.pcap", "scan2d.log", "ahrs.log"})
+    fs::copy_file(session(f), bad / f, fs::copy_options::overwrite_existing);
   auto in = io::ByteLogReader::open(session("gnss.log"));
   ASSERT_TRUE(in.has_value());
   auto out = io::ByteLogWriter::create((bad / "gnss.log").string(), in->source());
@@ -425,8 +434,8 @@ TEST_F(ReplayFusion, AGnssPositionJumpStopsTheTractorAsASensorFault) {
   const auto first = std::find_if(jumped.sensor_fault_us.begin(), jumped.sensor_fault_us.end(),
                                   [&](long long us) { return us >= jump_us; });
   ASSERT_NE(first, jumped.sensor_fault_us.end()) << "no sensor-fault stop after the jump";
-  std::printf("GNSS position jump (GGA %d): STOP, sensor fault, decided %.3f s after it arrived\n", gga >= 80 ? 80 : gga,
-              static_cast<double>(*first - jump_us) * 1e-6);
+  std::printf("GNSS position jump (GGA %d): STOP, sensor fault, decided %.3f s after it arrived\n",
+              gga >= 80 ? 80 : gga, static_cast<double>(*first - jump_us) * 1e-6);
   EXPECT_LE(*first - jump_us, 600'000);
 }
 
@@ -477,9 +486,10 @@ TEST_F(ReplayFusion, LowBoxInFrontOfTheBumperIsFoundFromThe2dScanOnly) {
   for (const Json& f : without) {
     for (const Json& o : f.at("obstacles")) found_without += in_front(o) ? 1U : 0U;
   }
-  std::printf("low box 1 m in front of the bumper: found in %zu of the last 20 frames with the 2D scan (its footprint "
-              "within %.2f m of the truth's centre on the plane), %zu without it\n",
-              found, worst_plane, found_without);
+  std::printf(
+      "low box 1 m in front of the bumper: found in %zu of the last 20 frames with the 2D scan (its footprint "
+      "within %.2f m of the truth's centre on the plane), %zu without it\n",
+      found, worst_plane, found_without);
   EXPECT_EQ(found, 20U);
   EXPECT_EQ(found_without, 0U);
   // The scan sees the box's near face: its footprint's centre lies within half the box's 0.4 m depth and the

@@ -233,12 +233,16 @@ class RunE2e : public ::testing::Test {
   // frames fused at 10 Hz: one frame per rotation of the 10 Hz capture, frame counter = rotation index.
   fs::path write_fused_config(std::uint16_t port, std::uint16_t scip_port, const fs::path& log) const {
     std::string text = config_text(port, log);
-    text = replaced(text, "\nscan2d:                          # Hokuyo UTM-30LX-EW 2D LiDAR, SCIP 2.0 over TCP: the near blind zone in front\n  enabled: false ",
+    text = replaced(text,
+                    "\nscan2d:                          # Hokuyo UTM-30LX-EW 2D LiDAR, SCIP 2.0 over TCP: the near "
+                    "blind zone in front\n  enabled: false ",
                     "\nscan2d:\n  enabled: true ");
     text = replaced(text, "\n  host: 192.168.0.10 ", "\n  host: 127.0.0.1 ");
     text = replaced(text, "\n  port: 10940 ", "\n  port: " + std::to_string(scip_port) + " ");
-    text = replaced(text, "\n  enabled: false\n  device: /dev/ttyUSB0 ", "\n  enabled: true\n  device: " + (dir.path() / "gnss").string() + " ");
-    text = replaced(text, "\n  enabled: false\n  device: /dev/ttyUSB1\n", "\n  enabled: true\n  device: " + (dir.path() / "ahrs").string() + "\n");
+    text = replaced(text, "\n  enabled: false\n  device: /dev/ttyUSB0 ",
+                    "\n  enabled: true\n  device: " + (dir.path() / "gnss").string() + " ");
+    text = replaced(text, "\n  enabled: false\n  device: /dev/ttyUSB1\n",
+                    "\n  enabled: true\n  device: " + (dir.path() / "ahrs").string() + "\n");
     text = replaced(text, "\n  rate_hz: 5.0 ", "\n  rate_hz: 10.0 ");
     text = replaced(text, "\n      max: [12.0, 4.0, 1.0]", "\n      max: [6.0, 4.0, 1.0]");
     // The tractor's speed from a bus this machine does not have (no SocketCAN): the daemon runs on with the
@@ -274,11 +278,15 @@ std::unique_ptr<testing::PedestrianCapture> RunE2e::capture_;
 std::string RunE2e::pcap_;
 std::string RunE2e::truth_;
 
-TEST_F(RunE2e, PedestrianStopsClearGoesSilenceStopsAndSigtermEndsWithAStop) { pedestrian_stops_clear_goes_silence_stops(false); }
+TEST_F(RunE2e, PedestrianStopsClearGoesSilenceStopsAndSigtermEndsWithAStop) {
+  pedestrian_stops_clear_goes_silence_stops(false);
+}
 
 // The same with every sensor emulated live: the 2D LiDAR over loopback TCP, GNSS and AHRS on pseudo-terminals,
 // frames fused by sync and compensated by geo before detection.
-TEST_F(RunE2e, FusedFromEveryLiveSensorPedestrianStopsClearGoesSilenceStops) { pedestrian_stops_clear_goes_silence_stops(true); }
+TEST_F(RunE2e, FusedFromEveryLiveSensorPedestrianStopsClearGoesSilenceStops) {
+  pedestrian_stops_clear_goes_silence_stops(true);
+}
 
 void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   const std::uint16_t port = free_udp_port();
@@ -400,8 +408,8 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     const Stop& now = d.by_frame.at(k);
     const Stop& next = d.by_frame.at(k + 1);
     EXPECT_TRUE((now.command == 1 && now.obstacle) || (next.command == 1 && next.obstacle))
-        << "the pedestrian is in the zone at rotation " << k << " but rotations " << k << " and " << k + 1
-        << " say " << now.command << " and " << next.command;
+        << "the pedestrian is in the zone at rotation " << k << " but rotations " << k << " and " << k + 1 << " say "
+        << now.command << " and " << next.command;
   }
   EXPECT_GE(entries, 3);
   // (c) after it leaves: STOP held for clear - 1 more rotations, GO once `clear` rotations were clear.
@@ -459,9 +467,10 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   const double from_silence = static_cast<double>(fault->us - silent_us) * 1e-6;
   EXPECT_LE(from_silence, timeout + kPeriod) << "STOP came " << from_silence << " s after the last packet";
   EXPECT_GE(from_silence, timeout - 0.05) << "STOP for silence before the timeout";
-  std::printf("[ measured ] silence STOP %.3f s after the last decided rotation (bound %.3f s), %.3f s after the "
-              "last packet (bound: timeout + one frame, %.3f s)\n",
-              after_s, 2 * kPeriod + timeout, from_silence, timeout + kPeriod);
+  std::printf(
+      "[ measured ] silence STOP %.3f s after the last decided rotation (bound %.3f s), %.3f s after the "
+      "last packet (bound: timeout + one frame, %.3f s)\n",
+      after_s, 2 * kPeriod + timeout, from_silence, timeout + kPeriod);
   // Every stop request after it says STOP, and the heartbeats report the LiDAR at fault (1).
   for (auto it = fault; it != d.stops.end(); ++it) EXPECT_EQ(it->command, 1);
   for (std::size_t i = 0; i < d.heartbeats.size(); ++i) {
@@ -557,7 +566,8 @@ int count_with(const std::vector<std::string>& msgs, const std::string& text) {
 // The tid of the daemon's (first) perception worker, named by the daemon.
 std::optional<pid_t> worker_tid(pid_t pid) {
   for (const auto& e : fs::directory_iterator("/proc/" + std::to_string(pid) + "/task")) {
-    if (slurp(e.path() / "comm").rfind("fg-perception", 0) == 0) return static_cast<pid_t>(std::stol(e.path().filename()));
+    if (slurp(e.path() / "comm").rfind("fg-perception", 0) == 0)
+      return static_cast<pid_t>(std::stol(e.path().filename()));
   }
   return std::nullopt;
 }
@@ -621,7 +631,8 @@ TEST_F(RunE2e, NotifyReadyThenWatchdogWhileHealthyAndNoneWhileAWorkerHangs) {
   EXPECT_GE(count_with(msgs, "STOPPING=1"), 1);
   // The CAN log says why it stopped while the worker hung.
   const Decoded d = decode_log(slurp(log));
-  EXPECT_TRUE(std::any_of(d.stops.begin(), d.stops.end(), [](const Stop& s) { return s.command == 1 && s.pipeline_late; }));
+  EXPECT_TRUE(
+      std::any_of(d.stops.begin(), d.stops.end(), [](const Stop& s) { return s.command == 1 && s.pipeline_late; }));
 }
 
 }  // namespace

@@ -1,12 +1,12 @@
 // The daemon's output stage on a fake clock: decisions between rotations reach the bus at once.
 #include "daemon/run_stage.hpp"
-#include "fieldguard/output/safety_params.hpp"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
 #include "fieldguard/output/can_layout.hpp"
+#include "fieldguard/output/safety_params.hpp"
 
 namespace fieldguard::app {
 namespace {

@@ -3,7 +3,6 @@
 #include "daemon/systemd_notify.hpp"
 
 #include <gtest/gtest.h>
-
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
@@ -149,7 +148,9 @@ TEST(SystemdNotifierOutsideSystemd, EverythingIsANoOp) {
 }
 
 TEST(OneLine, ControlCharactersBecomeSpaces) {
-  EXPECT_EQ(one_line("a\nb\tc\x7f" "d"), "a b c d");
+  EXPECT_EQ(one_line("a\nb\tc\x7f"
+                     "d"),
+            "a b c d");
   EXPECT_EQ(one_line("plain"), "plain");
 }
 

@@ -26,8 +26,8 @@ TEST(LatencyStats, QuantilesToTheBucketEdgeAndTheExactMaximum) {
 
 TEST(LatencyStats, LongAndNegativeDurationsStayCounted) {
   LatencyStats s;
-  s.add(-5);                 // a clock step: counted as 0
-  s.add(3'000'000 * kUs);    // 3 s: past the last bucket, still the maximum
+  s.add(-5);               // a clock step: counted as 0
+  s.add(3'000'000 * kUs);  // 3 s: past the last bucket, still the maximum
   EXPECT_EQ(s.count(), 2U);
   EXPECT_EQ(s.max_ns(), 3'000'000 * kUs);
   EXPECT_EQ(s.quantile_ns(0.5), LatencyStats::kBucketNs);

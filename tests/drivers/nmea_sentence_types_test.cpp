@@ -35,7 +35,8 @@ TEST(NmeaSentence, DispatchesOnTheTypeWhateverTheTalker) {
     ASSERT_TRUE(std::holds_alternative<Hdt>(*hdt));
     EXPECT_EQ(talker_of(*hdt), talker);
     EXPECT_EQ(type_of(*hdt), "HDT");
-    const auto gga = parse_sentence(framed(std::string(talker) + "GGA,120000,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,"));
+    const auto gga =
+        parse_sentence(framed(std::string(talker) + "GGA,120000,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,"));
     ASSERT_TRUE(gga) << talker;
     EXPECT_EQ(std::get<Gga>(*gga).quality, 1);
   }
@@ -94,7 +95,8 @@ TEST(NmeaGga, EmptyQualityIsNotZero) {
   const auto g = parse_gga(framed("GPGGA,120000,4807.038,N,01131.000,E,,08,0.9,545.4,M,46.9,M,,"));
   ASSERT_TRUE(g);
   EXPECT_FALSE(g->quality.has_value());
-  const auto d = parse_gga("$GNGGA,133859.80,4134.50180205,N,09345.03586649,W,4,19,0.7,280.827,M,-31.442,M,5.8,0002*6D");
+  const auto d =
+      parse_gga("$GNGGA,133859.80,4134.50180205,N,09345.03586649,W,4,19,0.7,280.827,M,-31.442,M,5.8,0002*6D");
   ASSERT_TRUE(d);
   EXPECT_EQ(d->dgps_age_s, 5.8);
   EXPECT_EQ(d->dgps_station, "0002");

@@ -253,12 +253,10 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"TextAfterChecksum", std::string(kFuzzyRmc) + " x", true, Error::BadChecksum},
         Bad{"NoChecksum", without_checksum(kFuzzyRmc), true, Error::NoChecksum},
         Bad{"NoChecksumGga", without_checksum(kRtkFixedGga) + "\r\n", false, Error::NoChecksum},
-        Bad{"NoDollar", std::string(kFuzzyRmc).substr(1), true, Error::NoStart},
-        Bad{"Empty", "", true, Error::NoStart},
+        Bad{"NoDollar", std::string(kFuzzyRmc).substr(1), true, Error::NoStart}, Bad{"Empty", "", true, Error::NoStart},
         Bad{"OnlyLineEnd", "\r\n", false, Error::NoStart},
         Bad{"TwoMerged", without_checksum(kRtkFixedGga) + kFuzzyRmc, true, Error::TooLong},
-        Bad{"GgaAsRmc", kRtkFixedGga, true, Error::Unsupported},
-        Bad{"VtgAsGga", kHemiVtg, false, Error::Unsupported},
+        Bad{"GgaAsRmc", kRtkFixedGga, true, Error::Unsupported}, Bad{"VtgAsGga", kHemiVtg, false, Error::Unsupported},
         Bad{"RmcAsGga", kFuzzyRmc, false, Error::Unsupported},
         Bad{"DollarInside", framed("GPRMC,1200$00,A,,,,,,,010120,,"), true, Error::BadField},
         Bad{"ControlChar", framed("GPRMC,120000,A,,,,,,,010120,,\x01"), true, Error::BadField},
@@ -283,8 +281,8 @@ INSTANTIATE_TEST_SUITE_P(
             Error::BadField},
         Bad{"NegativeSatellites", framed("GPGGA,123519,4807.038,N,01131.000,E,1,-8,0.9,545.4,M,46.9,M,,"), false,
             Error::BadField},
-        Bad{"HugeSatellites", framed("GPGGA,123519,4807.038,N,01131.000,E,1,99999999999,0.9,545.4,M,46.9,M,,"),
-            false, Error::BadField},
+        Bad{"HugeSatellites", framed("GPGGA,123519,4807.038,N,01131.000,E,1,99999999999,0.9,545.4,M,46.9,M,,"), false,
+            Error::BadField},
         Bad{"TruncatedGga", framed("GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M"), false, Error::BadField}),
     [](const auto& tp) { return std::string(tp.param.name); });
 
@@ -292,7 +290,7 @@ TEST(NmeaRmc, LongestAcceptedSentence) {
   // 120 characters from '$' to the checksum (real receivers exceed the standard's 80); 121 is too long.
   std::string body = "GPRMC,120000,A,,,,,,,010120,,,A,";
   body += std::string(120 - 4 - body.size() - 1, ' ');  // blanks trim away
-  body += "V";  // the 13th field (navigational status) is not read
+  body += "V";                                          // the 13th field (navigational status) is not read
   const std::string ok = framed(body);
   ASSERT_EQ(ok.size(), 120U);
   EXPECT_TRUE(parse_rmc(ok));

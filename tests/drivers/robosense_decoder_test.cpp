@@ -41,8 +41,16 @@ TEST(RoboSenseTime, WorkedExampleIsUtc) {
 TEST(RoboSenseTime, LeapYearsAndRanges) {
   auto at = [](std::uint8_t y, std::uint8_t mo, std::uint8_t d, std::uint8_t h = 0, std::uint8_t mi = 0,
                std::uint8_t s = 0, std::uint16_t ms = 0, std::uint16_t us = 0) {
-    const std::vector<std::uint8_t> b = {y,  mo, d, h, mi, s, static_cast<std::uint8_t>(ms >> 8), static_cast<std::uint8_t>(ms),
-                                         static_cast<std::uint8_t>(us >> 8), static_cast<std::uint8_t>(us)};
+    const std::vector<std::uint8_t> b = {y,
+                                         mo,
+                                         d,
+                                         h,
+                                         mi,
+                                         s,
+                                         static_cast<std::uint8_t>(ms >> 8),
+                                         static_cast<std::uint8_t>(ms),
+                                         static_cast<std::uint8_t>(us >> 8),
+                                         static_cast<std::uint8_t>(us)};
     return decode_ymd_time(b);
   };
   EXPECT_EQ(at(0, 1, 1)->ns, 946'684'800'000'000'000LL);      // 2000-01-01, a leap year divisible by 400
@@ -197,7 +205,7 @@ TEST(RoboSenseMsop, DualReturnPairsAndLabels) {
   m.channel(0, 0, 2000, 1).channel(1, 0, 3000, 2);  // last return farther than the strongest
   m.channel(0, 1, 3000, 3).channel(1, 1, 2000, 4);  // nearer second: the strongest was also the last
   m.channel(0, 2, 2500, 5).channel(1, 2, 2500, 5);  // one return only
-  m.channel(2, 0, 1000, 6);                          // second pair, strongest only
+  m.channel(2, 0, 1000, 6);                         // second pair, strongest only
   std::vector<LidarPoint> pts;
   ASSERT_TRUE(d.decode(m.span(), pts).has_value());
   ASSERT_EQ(pts.size(), 6U);

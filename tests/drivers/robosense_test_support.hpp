@@ -15,13 +15,14 @@ namespace fieldguard::robosense::test {
 // The bench table of one real unit from ros_rslidar rs_lidar_32/angle.csv (protocols.md §2.4; an example,
 // not a spec), channel 0..31, degrees.
 inline constexpr std::array<double, kChannels> kExampleVertDeg = {
-    -10.26, 0.30,  -6.41, -0.02, 2.28,  -0.33, 3.30,  -0.67, 4.61,  1.68,  7.02,  1.30,  10.30, 1.00,  15.02, 0.70,
+    -10.26, 0.30,  -6.41,  -0.02, 2.28,  -0.33, 3.30,  -0.67, 4.61,  1.68,  7.02,  1.30,  10.30, 1.00,  15.02, 0.70,
     -25.00, -2.28, -14.64, -2.67, -7.91, -3.02, -5.41, -3.30, -3.65, -1.02, -4.05, -1.33, -4.39, -1.63, -4.65, -1.98};
 
 inline Calibration example_calibration() {
   Calibration c;
   c.vert_deg = kExampleVertDeg;
-  for (std::size_t i = 0; i < kChannels; ++i) c.horiz_deg[i] = (i % 2 == 0 ? 1.0 : -1.0) * 0.05 * static_cast<double>(i % 5);
+  for (std::size_t i = 0; i < kChannels; ++i)
+    c.horiz_deg[i] = (i % 2 == 0 ? 1.0 : -1.0) * 0.05 * static_cast<double>(i % 5);
   return c;
 }
 
@@ -135,7 +136,8 @@ class DifopBuilder {
   }
   DifopBuilder& angles(const Calibration& cal) {
     for (std::size_t c = 0; c < kChannels; ++c) {
-      for (auto [offset, deg] : {std::pair{std::size_t{468}, cal.vert_deg[c]}, std::pair{std::size_t{564}, cal.horiz_deg[c]}}) {
+      for (auto [offset, deg] :
+           {std::pair{std::size_t{468}, cal.vert_deg[c]}, std::pair{std::size_t{564}, cal.horiz_deg[c]}}) {
         const long m = std::lround(deg * 1000.0);
         triplet(offset, c, m < 0 ? 0x01 : 0x00, static_cast<std::uint16_t>(m < 0 ? -m : m));
       }
@@ -143,7 +145,8 @@ class DifopBuilder {
     return *this;
   }
   DifopBuilder& fill_table(std::size_t offset, std::uint8_t v) {
-    std::fill(b_.begin() + static_cast<std::ptrdiff_t>(offset), b_.begin() + static_cast<std::ptrdiff_t>(offset + 96), v);
+    std::fill(b_.begin() + static_cast<std::ptrdiff_t>(offset), b_.begin() + static_cast<std::ptrdiff_t>(offset + 96),
+              v);
     return *this;
   }
   std::vector<std::uint8_t>& bytes() { return b_; }

@@ -87,8 +87,8 @@ TEST(RotationAssemblerInPlace, RealCapturesGiveTheReferenceFrames) {
       const Decoded dec = decode_capture(c.file, c.model, cal);
       ASSERT_FALSE(dec.points.empty()) << c.file;
       for (double cut : {0.0, 90.0, 150.0, 359.99, -45.0}) {
-        const std::string what = std::string(c.file) + " cut " + std::to_string(cut) +
-                                 (corrections ? " with corrections" : "");
+        const std::string what =
+            std::string(c.file) + " cut " + std::to_string(cut) + (corrections ? " with corrections" : "");
         reference::RotationAssembler ref(cut);
         RotationAssembler pushed(cut);
         RotationAssembler in_place(cut);

@@ -11,7 +11,7 @@
 namespace fieldguard {
 namespace {
 
-constexpr std::int64_t kPointNs = 10'000;    // 10 us between points
+constexpr std::int64_t kPointNs = 10'000;  // 10 us between points
 constexpr std::int64_t kHostDelayNs = 700'000;
 
 // A synthetic sensor: point i at azimuth start + i * step (0.01 deg), sensor time t0 + i * 10 us, packets of
@@ -111,8 +111,8 @@ TEST(RotationAssembler, CutAtZeroAndNegativeCutAngle) {
   const auto f0 = s.run(at_zero, 600);  // 600 * 0.5 deg: 350 -> 0 -> 290 deg
   ASSERT_EQ(f0.size(), 2U);
   EXPECT_EQ(f0[1].points.front().azimuth_cdeg, 0);
-  RotationAssembler minus(-90.0);          // = 270 deg
-  const auto f1 = s.run(minus, 600);       // 350 -> 0 -> 270 -> 290 deg: cut once at 270
+  RotationAssembler minus(-90.0);     // = 270 deg
+  const auto f1 = s.run(minus, 600);  // 350 -> 0 -> 270 -> 290 deg: cut once at 270
   ASSERT_EQ(f1.size(), 2U);
   EXPECT_EQ(f1[1].points.front().azimuth_cdeg, 27000);
   EXPECT_TRUE(f1[0].partial);
@@ -162,7 +162,7 @@ TEST(RotationAssembler, GapsCutOnlyWhenTheyCrossTheCut) {
   one(25000);  // lost packets, forward 240 deg without crossing 0
   one(26000);
   EXPECT_TRUE(done.empty());
-  one(500);    // lost packets across 0
+  one(500);  // lost packets across 0
   EXPECT_EQ(done.size(), 1U);
   a.finish(done);
   ASSERT_EQ(done.size(), 2U);

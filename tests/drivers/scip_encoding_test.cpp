@@ -102,7 +102,7 @@ TEST(ScipCommands, EchoForms) {
   EXPECT_EQ(command_of_echo("ME0000108001000;0123456789abcdef"), Command::ME);
   EXPECT_EQ(command_of_echo("GD0540054200"), Command::GD);
   EXPECT_EQ(command_of_echo("TM1"), Command::TM);
-  EXPECT_EQ(command_of_echo("MD000010800000"), Command::Unknown);   // one digit short
+  EXPECT_EQ(command_of_echo("MD000010800000"), Command::Unknown);    // one digit short
   EXPECT_EQ(command_of_echo("MD00001080000001"), Command::Unknown);  // one too many
   EXPECT_EQ(command_of_echo("MD0000108000000;"), Command::Unknown);
   EXPECT_EQ(command_of_echo("ME0000108001000;0123456789abcdefg"), Command::Unknown);

@@ -21,7 +21,9 @@ struct Case {
   Decode decode = Decode::None;  // None: a framing error the parser counts
 };
 
-std::string gd(std::string_view data) { return "GD0540054200\n" + test::line("00") + test::line("4]J7") + test::data_lines(data) + "\n"; }
+std::string gd(std::string_view data) {
+  return "GD0540054200\n" + test::line("00") + test::line("4]J7") + test::data_lines(data) + "\n";
+}
 
 std::string too_long_scan() {
   std::string s = "MD0000108000000\n" + test::line("99") + test::line("0000");
@@ -58,9 +60,11 @@ std::vector<Case> cases() {
        Error::BadDataLength, Decode::Scan},
       {"timestamp_short", "GD0540054200\n00P\n" + test::line("4]J") + test::data_lines("1Dh0CB>YP") + "\n",
        Error::BadDataLength, Decode::Scan},
-      {"pp_missing_dmax", test::simple_reply("PP", "00", test::info_line("DMIN", "23") + test::info_line("ARES", "1440")),
-       Error::BadField, Decode::Parameters},
-      {"pp_not_a_number", test::simple_reply("PP", "00", test::info_line("DMIN", "2x3")), Error::BadField, Decode::Parameters},
+      {"pp_missing_dmax",
+       test::simple_reply("PP", "00", test::info_line("DMIN", "23") + test::info_line("ARES", "1440")), Error::BadField,
+       Decode::Parameters},
+      {"pp_not_a_number", test::simple_reply("PP", "00", test::info_line("DMIN", "2x3")), Error::BadField,
+       Decode::Parameters},
       {"info_without_colon", test::simple_reply("VV", "00", test::line("VEND Hokuyo")), Error::BadField, Decode::Info},
   };
 }

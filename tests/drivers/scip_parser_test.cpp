@@ -226,7 +226,8 @@ TEST(ScipParser, ParametersVersionAndState) {
 
 TEST(ScipParser, CheckCharacterWithOrWithoutTheSemicolon) {
   ReplyParser p;
-  const std::string reply = test::simple_reply("PP", "00", test::info_line("DMIN", "23", true) + test::info_line("DMAX", "60000"));
+  const std::string reply =
+      test::simple_reply("PP", "00", test::info_line("DMIN", "23", true) + test::info_line("DMAX", "60000"));
   const auto out = test::parse_all(p, reply);
   ASSERT_EQ(out.size(), 1U);
   EXPECT_EQ(p.counters().rejected(), 0U);

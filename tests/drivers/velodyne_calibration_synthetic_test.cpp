@@ -1,8 +1,6 @@
 // Calibration parsers on files built in the test: units, laser ids, and one specific error per kind of damage.
 // The real files (VeloView's HDL-32.xml, VLP-16.xml) and the defaults: velodyne_calibration_test.cpp.
 
-#include "fieldguard/drivers/velodyne_calibration.hpp"
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -13,11 +11,12 @@
 #include <utility>
 #include <vector>
 
+#include "fieldguard/drivers/velodyne_calibration.hpp"
+
 namespace fieldguard::velodyne {
 namespace {
 
 using ::testing::HasSubstr;
-
 
 using Fields = std::vector<std::pair<std::string, std::string>>;
 
@@ -50,11 +49,15 @@ double default_vert_deg(std::size_t id) {
 }
 
 Fields ros_laser(std::size_t id) {
-  return {{"laser_id", std::to_string(id)},          {"rot_correction", "0.0"},
+  return {{"laser_id", std::to_string(id)},
+          {"rot_correction", "0.0"},
           {"vert_correction", num(default_vert_deg(id) * std::numbers::pi / 180.0)},
-          {"dist_correction", "0.0"},                 {"dist_correction_x", "0.0"},
-          {"dist_correction_y", "0.0"},               {"vert_offset_correction", "0.0"},
-          {"horiz_offset_correction", "0.0"},         {"focal_distance", "0.0"},
+          {"dist_correction", "0.0"},
+          {"dist_correction_x", "0.0"},
+          {"dist_correction_y", "0.0"},
+          {"vert_offset_correction", "0.0"},
+          {"horiz_offset_correction", "0.0"},
+          {"focal_distance", "0.0"},
           {"focal_slope", "0.0"}};
 }
 
@@ -75,9 +78,15 @@ std::string ros_yaml(const std::vector<Fields>& lasers, const std::string& head 
 }
 
 Fields db_point(std::size_t id) {
-  return {{"id_", std::to_string(id)},     {"rotCorrection_", "0"},          {"vertCorrection_", num(default_vert_deg(id))},
-          {"distCorrection_", "0"},        {"distCorrectionX_", "0"},        {"distCorrectionY_", "0"},
-          {"vertOffsetCorrection_", "0"},  {"horizOffsetCorrection_", "0"},  {"focalDistance_", "0"},
+  return {{"id_", std::to_string(id)},
+          {"rotCorrection_", "0"},
+          {"vertCorrection_", num(default_vert_deg(id))},
+          {"distCorrection_", "0"},
+          {"distCorrectionX_", "0"},
+          {"distCorrectionY_", "0"},
+          {"vertOffsetCorrection_", "0"},
+          {"horizOffsetCorrection_", "0"},
+          {"focalDistance_", "0"},
           {"focalSlope_", "0"}};
 }
 
@@ -123,7 +132,7 @@ std::vector<int> with_gap() {
 
 TEST(VelodyneCalibration, RosYamlUnitsAndLaserIds) {
   auto lasers = ros_lasers(16);
-  std::reverse(lasers.begin(), lasers.end());  // stored by laser_id, not by position
+  std::reverse(lasers.begin(), lasers.end());             // stored by laser_id, not by position
   lasers[0] = with(lasers[0], "rot_correction", "-0.1");  // laser_id 15
   lasers[0] = with(lasers[0], "dist_correction", "1.25");
   lasers[0] = with(lasers[0], "vert_offset_correction", "0.0112");
@@ -220,7 +229,8 @@ std::vector<Malformed> malformed_cases() {
       {"RosBadResolution", Format::Ros, ros_yaml(ros_lasers(32), "num_lasers: 32\ndistance_resolution: 0.2\n"),
        "distance_resolution '0.2' is not a distance in metres"},
       {"DbNotXml", Format::Db, "this is <not xml", "not valid XML"},
-      {"DbNoDb", Format::Db, "<boost_serialization><Other/></boost_serialization>", "not a db.xml: no DB/points_ element"},
+      {"DbNoDb", Format::Db, "<boost_serialization><Other/></boost_serialization>",
+       "not a db.xml: no DB/points_ element"},
       {"DbNoPoints", Format::Db, "<boost_serialization><DB><distLSB_>0.2</distLSB_></DB></boost_serialization>",
        "not a db.xml: no DB/points_ element"},
       {"DbUnsupportedCount", Format::Db, db_xml(db_points(31), {}),
@@ -230,7 +240,8 @@ std::vector<Malformed> malformed_cases() {
       {"DbMissingField", Format::Db, db_xml(db_missing_vert, {}), "laser 7: vertCorrection_ missing"},
       {"DbNonNumericField", Format::Db, db_xml(db_word, {}), "laser 3: distCorrection_ is not a number: '12cm'"},
       {"DbDuplicateId", Format::Db, db_xml(db_dup, enabled_run(32, 33)), "laser 32: id_ 0 appears twice"},
-      {"DbEnabledGap", Format::Db, db_xml(db_points(32), with_gap()), "enabled_ item 20 is enabled after disabled laser 16"},
+      {"DbEnabledGap", Format::Db, db_xml(db_points(32), with_gap()),
+       "enabled_ item 20 is enabled after disabled laser 16"},
       {"DbNestedTooDeep", Format::Db, repeated("<a>", 20000), "elements nest more than 64 deep"},
   };
 }

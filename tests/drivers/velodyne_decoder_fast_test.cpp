@@ -32,10 +32,10 @@ double xy_tolerance(const LidarPoint& p) { return 1e-6 * static_cast<double>(p.r
 
 struct Diff {
   std::size_t points = 0;
-  double max_xy_m = 0.0;        // largest |(x, y) fast - (x, y) reference|
-  double max_xy_ratio = 0.0;    // ... relative to xy_tolerance()
-  std::size_t packets = 0;      // decoded without an error
-  std::size_t bounded = 0;      // ... of them with azimuth bounds narrower than every azimuth (AzimuthRange)
+  double max_xy_m = 0.0;      // largest |(x, y) fast - (x, y) reference|
+  double max_xy_ratio = 0.0;  // ... relative to xy_tolerance()
+  std::size_t packets = 0;    // decoded without an error
+  std::size_t bounded = 0;    // ... of them with azimuth bounds narrower than every azimuth (AzimuthRange)
 };
 
 // Everything but x and y bit for bit; x and y within xy_tolerance().
@@ -56,8 +56,7 @@ void expect_same_points(const std::vector<LidarPoint>& fast, const std::vector<L
     ASSERT_EQ(a.reserved1, 0);
     const double d = std::hypot(static_cast<double>(a.x) - static_cast<double>(b.x),
                                 static_cast<double>(a.y) - static_cast<double>(b.y));
-    ASSERT_LE(d, xy_tolerance(b)) << what << " point " << i << " range " << b.range_m << " azimuth "
-                                  << b.azimuth_cdeg;
+    ASSERT_LE(d, xy_tolerance(b)) << what << " point " << i << " range " << b.range_m << " azimuth " << b.azimuth_cdeg;
     diff.max_xy_m = std::max(diff.max_xy_m, d);
     diff.max_xy_ratio = std::max(diff.max_xy_ratio, d / xy_tolerance(b));
   }
@@ -255,8 +254,10 @@ TEST(VelodyneDecoderFast, RandomPacketsMatchTheReferenceDecoder) {
         for (std::size_t b = 0; b < kBlocksPerPacket; ++b) {
           for (std::size_t s = 0; s < kSlotsPerBlock; ++s) {
             const int kind = uniform(0, 9);
-            const int raw = kind == 0 ? 0 : kind == 1 ? uniform(1, 300) : kind == 2 ? uniform(64900, 65535)
-                                                                       : uniform(1, 65535);
+            const int raw = kind == 0   ? 0
+                            : kind == 1 ? uniform(1, 300)
+                            : kind == 2 ? uniform(64900, 65535)
+                                        : uniform(1, 65535);
             p.slot(b, s, static_cast<std::uint16_t>(raw), static_cast<std::uint8_t>(uniform(0, 255)));
           }
         }
@@ -279,9 +280,9 @@ TEST(VelodyneDecoderFast, RandomPacketsMatchTheReferenceDecoder) {
           o.timestamp_reference = ref;
           o.min_range_m = calib == 1 ? 0.0 : 0.5;
           const Calibration cal = calib == 0 ? default_calibration(m) : calib == 1 ? corrected(m) : huge_rotations(m);
-          compare_packets(packets, cal, o, diff,
-                          std::string(to_string(m)) + " mode " + std::to_string(mode) + " calibration " +
-                              std::to_string(calib));
+          compare_packets(
+              packets, cal, o, diff,
+              std::string(to_string(m)) + " mode " + std::to_string(mode) + " calibration " + std::to_string(calib));
           if (HasFatalFailure()) return;
         }
       }
@@ -396,10 +397,10 @@ TEST(VelodyneDecoderFast, RangeTestInIntegersMatchesFloatTest) {
   };
   const double inf = std::numeric_limits<double>::infinity();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const Case cases[] = {{0.0, 0.5, 130.0, 0.002},  {1.2, 0.5, 130.0, 0.002},  {-0.3, 0.0, 130.0, 0.002},
-                        {0.0, 0.0, inf, 0.002},    {0.0, 131.0, 130.0, 0.002}, {0.0, 0.5, 130.0, 0.004},
-                        {0.0, nan, 130.0, 0.002},  {0.0, 0.5, nan, 0.002},     {2.0, 2.0, 2.0, 0.002},
-                        {0.0, 0.5, 1e-3, 1e-7},    {-inf, 0.5, 130.0, 0.002},  {nan, 0.5, 130.0, 0.002}};
+  const Case cases[] = {{0.0, 0.5, 130.0, 0.002}, {1.2, 0.5, 130.0, 0.002},   {-0.3, 0.0, 130.0, 0.002},
+                        {0.0, 0.0, inf, 0.002},   {0.0, 131.0, 130.0, 0.002}, {0.0, 0.5, 130.0, 0.004},
+                        {0.0, nan, 130.0, 0.002}, {0.0, 0.5, nan, 0.002},     {2.0, 2.0, 2.0, 0.002},
+                        {0.0, 0.5, 1e-3, 1e-7},   {-inf, 0.5, 130.0, 0.002},  {nan, 0.5, 130.0, 0.002}};
   std::size_t cases_run = 0;
   for (const Case& c : cases) {
     Calibration cal = default_calibration(Model::VLP16);
@@ -484,8 +485,8 @@ TEST(VelodyneDecoderFast, AzimuthTableErrorAt130m) {
           const LidarPoint& q = pts[b * kSlotsPerBlock + s];
           const double w = cal.lasers[s].vert_deg * std::numbers::pi / 180.0;
           const double xy = static_cast<double>(q.range_m) * static_cast<double>(static_cast<float>(std::cos(w)));
-          const double err = std::hypot(static_cast<double>(q.x) - xy * std::cos(rad),
-                                        static_cast<double>(q.y) + xy * std::sin(rad));
+          const double err =
+              std::hypot(static_cast<double>(q.x) - xy * std::cos(rad), static_cast<double>(q.y) + xy * std::sin(rad));
           max_err_m = std::max(max_err_m, err);
           max_err_rel = std::max(max_err_rel, err / xy);
           const LidarPoint& r = ref_pts[b * kSlotsPerBlock + s];

@@ -120,27 +120,29 @@ void set_flag(PacketBuilder& p, std::size_t block, std::uint8_t a, std::uint8_t 
 
 INSTANTIATE_TEST_SUITE_P(
     Malformed, VelodyneDecodeErrors,
-    ::testing::Values(
-        BadCase{"Empty", [](PacketBuilder& p) { p.bytes().clear(); }, Model::HDL32E, DecodeError::BadLength, true},
-        BadCase{"OneShort", [](PacketBuilder& p) { p.bytes().pop_back(); }, Model::HDL32E, DecodeError::BadLength, true},
-        BadCase{"OneLong", [](PacketBuilder& p) { p.bytes().push_back(0); }, Model::HDL32E, DecodeError::BadLength, true},
-        BadCase{"PositionPacketSize", [](PacketBuilder& p) { p.bytes().resize(kPositionPacketSize); }, Model::HDL32E,
-                DecodeError::BadLength, true},
-        BadCase{"FlagBytesSwapped", [](PacketBuilder& p) { set_flag(p, 0, 0xEE, 0xFF); }, Model::HDL32E,
-                DecodeError::BadBlockFlag, true},
-        BadCase{"LowerBankFlagInLastBlock", [](PacketBuilder& p) { set_flag(p, 11, 0xFF, 0xDD); }, Model::HDL32E,
-                DecodeError::BadBlockFlag, true},
-        BadCase{"Azimuth36000", [](PacketBuilder& p) { p.azimuth(5, 36000); }, Model::HDL32E, DecodeError::BadAzimuth,
-                true},
-        BadCase{"AzimuthFFFF", [](PacketBuilder& p) { p.azimuth(11, 0xFFFF); }, Model::VLP16, DecodeError::BadAzimuth,
-                true},
-        BadCase{"UnknownReturnByte", [](PacketBuilder& p) { p.factory(0x40, 0x21); }, Model::HDL32E,
-                DecodeError::BadReturnMode, true},
-        BadCase{"Vlp16ProductOnHdl32", [](PacketBuilder& p) { p.factory(0x37, 0x22); }, Model::HDL32E,
-                DecodeError::ModelMismatch, false},
-        BadCase{"Vlp32cProductOnVlp16", [](PacketBuilder& p) { p.factory(0x37, 0x28); }, Model::VLP16,
-                DecodeError::ModelMismatch, false},
-        BadCase{"ModelNotKnown", [](PacketBuilder&) {}, Model::Unknown, DecodeError::NoModel, false}),
+    ::testing::Values(BadCase{"Empty", [](PacketBuilder& p) { p.bytes().clear(); }, Model::HDL32E,
+                              DecodeError::BadLength, true},
+                      BadCase{"OneShort", [](PacketBuilder& p) { p.bytes().pop_back(); }, Model::HDL32E,
+                              DecodeError::BadLength, true},
+                      BadCase{"OneLong", [](PacketBuilder& p) { p.bytes().push_back(0); }, Model::HDL32E,
+                              DecodeError::BadLength, true},
+                      BadCase{"PositionPacketSize", [](PacketBuilder& p) { p.bytes().resize(kPositionPacketSize); },
+                              Model::HDL32E, DecodeError::BadLength, true},
+                      BadCase{"FlagBytesSwapped", [](PacketBuilder& p) { set_flag(p, 0, 0xEE, 0xFF); }, Model::HDL32E,
+                              DecodeError::BadBlockFlag, true},
+                      BadCase{"LowerBankFlagInLastBlock", [](PacketBuilder& p) { set_flag(p, 11, 0xFF, 0xDD); },
+                              Model::HDL32E, DecodeError::BadBlockFlag, true},
+                      BadCase{"Azimuth36000", [](PacketBuilder& p) { p.azimuth(5, 36000); }, Model::HDL32E,
+                              DecodeError::BadAzimuth, true},
+                      BadCase{"AzimuthFFFF", [](PacketBuilder& p) { p.azimuth(11, 0xFFFF); }, Model::VLP16,
+                              DecodeError::BadAzimuth, true},
+                      BadCase{"UnknownReturnByte", [](PacketBuilder& p) { p.factory(0x40, 0x21); }, Model::HDL32E,
+                              DecodeError::BadReturnMode, true},
+                      BadCase{"Vlp16ProductOnHdl32", [](PacketBuilder& p) { p.factory(0x37, 0x22); }, Model::HDL32E,
+                              DecodeError::ModelMismatch, false},
+                      BadCase{"Vlp32cProductOnVlp16", [](PacketBuilder& p) { p.factory(0x37, 0x28); }, Model::VLP16,
+                              DecodeError::ModelMismatch, false},
+                      BadCase{"ModelNotKnown", [](PacketBuilder&) {}, Model::Unknown, DecodeError::NoModel, false}),
     [](const ::testing::TestParamInfo<BadCase>& i) { return std::string(i.param.name); });
 
 TEST(VelodyneDecoder, ReturnModeFromLayoutWhenByteUnsetOrUnknown) {
@@ -166,10 +168,10 @@ TEST(VelodyneDecoder, ConstructorRejectsCalibrationOfTheWrongSize) {
 TEST(VelodyneDecoder, LastReturnModeAndRangeLimits) {
   PacketBuilder p;
   p.azimuths(0, 20).factory(0x38, 0x21);
-  p.slot(0, 0, 200, 1);     // 0.4 m < min 0.5: dropped
-  p.slot(0, 1, 250, 2);     // 0.5 m: kept
-  p.slot(0, 2, 65000, 3);   // 130 m: kept
-  p.slot(0, 3, 65001, 4);   // 130.002 m: dropped
+  p.slot(0, 0, 200, 1);    // 0.4 m < min 0.5: dropped
+  p.slot(0, 1, 250, 2);    // 0.5 m: kept
+  p.slot(0, 2, 65000, 3);  // 130 m: kept
+  p.slot(0, 3, 65001, 4);  // 130.002 m: dropped
   std::vector<LidarPoint> pts;
   ASSERT_TRUE(make_decoder(Model::HDL32E).decode(p.span(), pts).has_value());
   ASSERT_EQ(pts.size(), 2U);
@@ -181,7 +183,7 @@ TEST(VelodyneDecoder, LastReturnModeAndRangeLimits) {
 TEST(VelodyneDecoder, AppliesCalibrationCorrections) {
   Calibration cal = default_calibration(Model::HDL32E);
   LaserCorrection& c = cal.lasers[1];  // -9.33 deg
-  c.rot_deg = -1.5;  // the files' sign: subtracted, so -1.5 turns the firing 1.5 degrees clockwise
+  c.rot_deg = -1.5;                    // the files' sign: subtracted, so -1.5 turns the firing 1.5 degrees clockwise
   c.dist_m = 0.25;
   c.vert_offset_m = 0.02;
   c.horiz_offset_m = -0.03;
@@ -254,9 +256,9 @@ TEST(VelodyneDecoder, DualReturnPairs) {
 TEST(VelodyneDecoder, Vlp16TimingAndAzimuthInterpolation) {
   PacketBuilder p;
   p.azimuths(35900, 80).factory(0x37, 0x22).timestamp(1000);
-  p.slot(1, 5, 2500, 11);        // block 1, sequence 0, laser 5 (+5 deg)
-  p.slot(1, 16 + 5, 2500, 12);   // block 1, sequence 1, laser 5
-  p.slot(11, 31, 2500, 13);      // block 11, sequence 1, laser 15: the last firing
+  p.slot(1, 5, 2500, 11);       // block 1, sequence 0, laser 5 (+5 deg)
+  p.slot(1, 16 + 5, 2500, 12);  // block 1, sequence 1, laser 5
+  p.slot(11, 31, 2500, 13);     // block 11, sequence 1, laser 15: the last firing
   std::vector<LidarPoint> pts;
   ASSERT_TRUE(make_decoder(Model::VLP16).decode(p.span(), pts).has_value());
   ASSERT_EQ(pts.size(), 3U);
@@ -266,7 +268,8 @@ TEST(VelodyneDecoder, Vlp16TimingAndAzimuthInterpolation) {
   // Block 1 is at 359.80 deg and block 2 at 0.60 deg: 80 cdeg per 110.592 us, across the wrap.
   EXPECT_EQ(pts[0].azimuth_cdeg, 35988);  // 35980 + 80 * 11.52 / 110.592 = 35988.3
   EXPECT_EQ(pts[1].azimuth_cdeg, 28);     // 35980 + 80 * 66.816 / 110.592 = 36028.3
-  EXPECT_EQ(pts[2].azimuth_cdeg, static_cast<std::uint16_t>(std::lround((35900 + 11 * 80 + 80 * 89.856 / 110.592) - 36000)));
+  EXPECT_EQ(pts[2].azimuth_cdeg,
+            static_cast<std::uint16_t>(std::lround((35900 + 11 * 80 + 80 * 89.856 / 110.592) - 36000)));
   EXPECT_EQ(pts[0].ring, 10);
   EXPECT_EQ(pts[2].ring, 15);
   EXPECT_NEAR(pts[0].z, 5.0 * std::sin(deg2rad(5.0)), 1e-5);

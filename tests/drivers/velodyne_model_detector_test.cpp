@@ -117,7 +117,7 @@ TEST(VelodyneModelDetector, UndecidedOnContradictionOrUnsupportedModel) {
 TEST(VelodyneSensorTime, TakesTheHourFromTheHost) {
   constexpr std::int64_t kHour = 3'600'000'000'000LL;
   const std::int64_t hour = 1'700'000'000LL / 3600 * kHour;  // a top of the hour in 2023
-  const Stamp host{hour + 20 * 60'000'000'000LL};              // 20 min past
+  const Stamp host{hour + 20 * 60'000'000'000LL};            // 20 min past
   EXPECT_EQ(sensor_time_from_hour_offset(1'234'567'890U, host).ns, hour + 1'234'567'890'000LL);
   // Sensor at 59:59.9, host already at 00:00.2 of the next hour: the previous hour.
   EXPECT_EQ(sensor_time_from_hour_offset(3'599'900'000U, Stamp{hour + kHour + 200'000'000}).ns,

@@ -36,16 +36,16 @@ struct Packet {
 TEST(VelodynePosition, DecodesEveryField) {
   Packet p;
   // 12-bit two's complement in the low bits; the top nibble is not part of the value.
-  p.le16(14, 0x0FBB);   // gyro 0: -69
-  p.le16(16, 0x1044);   // temperature 0: 68
-  p.le16(18, 0x22FC);   // accel X 0: 764
-  p.le16(20, 0x3FFF);   // accel Y 0: -1
-  p.le16(22, 0xF7FF);   // gyro 1: +2047, the largest
-  p.le16(24, 0x0800);   // temperature 1: -2048, the smallest
+  p.le16(14, 0x0FBB);  // gyro 0: -69
+  p.le16(16, 0x1044);  // temperature 0: 68
+  p.le16(18, 0x22FC);  // accel X 0: 764
+  p.le16(20, 0x3FFF);  // accel Y 0: -1
+  p.le16(22, 0xF7FF);  // gyro 1: +2047, the largest
+  p.le16(24, 0x0800);  // temperature 1: -2048, the smallest
   p.le16(26, 0x0000);
   p.le16(28, 0x0001);
-  p.le16(30, 0x0FFF);   // gyro 2: -1
-  p.le16(32, 0x0000);   // temperature 2: 0 -> 25 degC
+  p.le16(30, 0x0FFF);  // gyro 2: -1
+  p.le16(32, 0x0000);  // temperature 2: 0 -> 25 degC
   p.le16(34, 0x07FF);
   p.le16(36, 0x0800);
   p.le32(198, 0x499602D2);  // 1 234 567 890 us
@@ -172,7 +172,7 @@ TEST(VelodynePosition, RealHdl32ePackets) {
     EXPECT_EQ(d->rmc->day, 11);
     EXPECT_EQ(d->rmc->month, 12);
     EXPECT_EQ(d->rmc->year, 2012);
-    EXPECT_NEAR(*d->rmc->lat_deg, 37.13054, 1e-6);    // Morgan Hill, CA
+    EXPECT_NEAR(*d->rmc->lat_deg, 37.13054, 1e-6);  // Morgan Hill, CA
     EXPECT_NEAR(*d->rmc->lon_deg, -121.654773, 1e-6);
     EXPECT_EQ(d->rmc->speed_mps, 0.0);
     EXPECT_EQ(d->rmc->course_deg, 144.7);
@@ -190,10 +190,10 @@ TEST(VelodynePosition, RealHdl32ePackets) {
   }
   const auto first = decode_position_packet(ByteSpan(all).first(kPositionPacketSize));
   ASSERT_TRUE(first);
-  EXPECT_NEAR(first->gyro_dps[0], -69 * 0.09766, 1e-12);      // word 0x0FBB
+  EXPECT_NEAR(first->gyro_dps[0], -69 * 0.09766, 1e-12);          // word 0x0FBB
   EXPECT_NEAR(first->temperature_c[0], 68 * 0.1453 + 25, 1e-12);  // word 0x1044
-  EXPECT_NEAR(first->accel_x_g[0], 764 * 0.001221, 1e-12);    // word 0x22FC
-  EXPECT_NEAR(first->accel_y_g[1], -43 * 0.001221, 1e-12);    // word 0x3FD5
+  EXPECT_NEAR(first->accel_x_g[0], 764 * 0.001221, 1e-12);        // word 0x22FC
+  EXPECT_NEAR(first->accel_y_g[1], -43 * 0.001221, 1e-12);        // word 0x3FD5
 }
 
 }  // namespace

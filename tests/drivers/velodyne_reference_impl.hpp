@@ -27,11 +27,10 @@ class Decoder {
     for (std::size_t i = 0; i < cal_.lasers.size(); ++i) {
       const LaserCorrection& c = cal_.lasers[i];
       const int ring = cal_.ring_of_laser[i];
-      table_.push_back(LaserTable{static_cast<float>(std::cos(c.vert_deg * kRadPerDeg)),
-                                  static_cast<float>(std::sin(c.vert_deg * kRadPerDeg)),
-                                  static_cast<float>(c.rot_deg * 100.0), static_cast<float>(c.dist_m),
-                                  static_cast<float>(c.vert_offset_m), static_cast<float>(c.horiz_offset_m),
-                                  static_cast<std::uint16_t>(ring < 0 ? 0 : ring)});
+      table_.push_back(LaserTable{
+          static_cast<float>(std::cos(c.vert_deg * kRadPerDeg)), static_cast<float>(std::sin(c.vert_deg * kRadPerDeg)),
+          static_cast<float>(c.rot_deg * 100.0), static_cast<float>(c.dist_m), static_cast<float>(c.vert_offset_m),
+          static_cast<float>(c.horiz_offset_m), static_cast<std::uint16_t>(ring < 0 ? 0 : ring)});
     }
   }
 
@@ -50,9 +49,9 @@ class Decoder {
     const bool dual = header.return_mode == ReturnMode::Dual || header.dual_layout;
     const std::size_t step = dual ? 2 : 1;
     const std::size_t groups = kBlocksPerPacket / step;
-    const float last_firing_us = static_cast<float>(groups - 1) * lay.block_us +
-                                 (static_cast<float>(lay.sequences - 1) * lay.sequence_us +
-                                  static_cast<float>(lay.lasers - 1) * lay.firing_us);
+    const float last_firing_us =
+        static_cast<float>(groups - 1) * lay.block_us +
+        (static_cast<float>(lay.sequences - 1) * lay.sequence_us + static_cast<float>(lay.lasers - 1) * lay.firing_us);
     const float ref_us = options_.timestamp_reference == TimestampReference::LastFiring ? last_firing_us : 0.F;
     std::array<float, kBlocksPerPacket> az{};
     std::array<float, kBlocksPerPacket> delta{};
@@ -81,8 +80,7 @@ class Decoder {
         for (std::size_t j = 0; j < lay.lasers; ++j) {
           const std::size_t slot = s * lay.lasers + j;
           const LaserTable& laser = table_[j];
-          const float in_block_us =
-              static_cast<float>(s) * lay.sequence_us + static_cast<float>(j) * lay.firing_us;
+          const float in_block_us = static_cast<float>(s) * lay.sequence_us + static_cast<float>(j) * lay.firing_us;
           const float azimuth = wrap_cdeg(az[g] + delta[g] * (in_block_us / lay.block_us) - laser.rot_cdeg);
           const float time_s = ((group_us + in_block_us) - ref_us) * 1e-6F;
           const float angle = azimuth * kRadPerCdeg;

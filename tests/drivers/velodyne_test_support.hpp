@@ -63,9 +63,9 @@ class PacketBuilder {
 };
 
 struct UdpRecord {
-  Stamp host;                          // pcap record time
+  Stamp host;  // pcap record time
   std::uint16_t dst_port = 0;
-  std::vector<std::uint8_t> payload;   // UDP payload (Ethernet + IPv4 without options + UDP = 42 bytes before it)
+  std::vector<std::uint8_t> payload;  // UDP payload (Ethernet + IPv4 without options + UDP = 42 bytes before it)
 };
 
 // Classic pcap (either byte order, µs or ns), linktype Ethernet, IPv4 without options. Returns the UDP records;
@@ -94,7 +94,8 @@ inline std::vector<UdpRecord> read_udp_records(const std::string& path) {
     constexpr std::size_t kUdpPayload = 42;
     if (frame.size() < kUdpPayload || load_be16(frame, 12) != 0x0800 || frame[14] != 0x45 || frame[23] != 17) continue;
     UdpRecord r;
-    r.host = Stamp{static_cast<std::int64_t>(sec) * 1'000'000'000 + static_cast<std::int64_t>(frac) * (nanos ? 1 : 1000)};
+    r.host =
+        Stamp{static_cast<std::int64_t>(sec) * 1'000'000'000 + static_cast<std::int64_t>(frac) * (nanos ? 1 : 1000)};
     r.dst_port = load_be16(frame, 36);
     const ByteSpan udp = frame.subspan(kUdpPayload);
     r.payload.assign(udp.begin(), udp.end());

@@ -1,12 +1,12 @@
 // Xbus frames: the worked frames of protocols.md §5.4 (the GoToConfig/GoToMeasurement ones match MT Manager
 // captures), extended length, and the ways a frame is refused.
 
-#include "fieldguard/drivers/xsens.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <vector>
+
+#include "fieldguard/drivers/xsens.hpp"
 
 namespace fieldguard::xsens {
 namespace {
@@ -23,11 +23,12 @@ TEST(XsensFrame, WorkedFrames) {
       {{0xFA, 0xFF, 0x30, 0x00, 0xD1}, mid::kGoToConfig, 0},
       {{0xFA, 0xFF, 0x10, 0x00, 0xF1}, mid::kGoToMeasurement, 0},
       {{0xFA, 0xFF, 0x00, 0x00, 0x01}, mid::kReqDeviceId, 0},
-      {{0xFA, 0xFF, 0x31, 0x00, 0xD0}, mid::kGoToConfigAck, 0},                             // MT Manager capture
-      {{0xFA, 0xFF, 0x03, 0x04, 0x03, 0x70, 0x03, 0xF8, 0x8C}, mid::kInitMtResults, 4},     // MT Manager capture
-      {{0xFA, 0xFF, 0xC0, 0x18, 0x10, 0x20, 0xFF, 0xFF, 0x10, 0x60, 0xFF, 0xFF, 0x20, 0x30, 0x00, 0x64,
-        0x40, 0x20, 0x00, 0x64, 0x80, 0x20, 0x00, 0x64, 0xE0, 0x20, 0xFF, 0xFF, 0x13},
-       mid::kSetOutputConfiguration, 24},
+      {{0xFA, 0xFF, 0x31, 0x00, 0xD0}, mid::kGoToConfigAck, 0},                          // MT Manager capture
+      {{0xFA, 0xFF, 0x03, 0x04, 0x03, 0x70, 0x03, 0xF8, 0x8C}, mid::kInitMtResults, 4},  // MT Manager capture
+      {{0xFA, 0xFF, 0xC0, 0x18, 0x10, 0x20, 0xFF, 0xFF, 0x10, 0x60, 0xFF, 0xFF, 0x20, 0x30, 0x00,
+        0x64, 0x40, 0x20, 0x00, 0x64, 0x80, 0x20, 0x00, 0x64, 0xE0, 0x20, 0xFF, 0xFF, 0x13},
+       mid::kSetOutputConfiguration,
+       24},
   };
   for (const auto& c : cases) {
     const auto m = decode_frame(c.frame);
@@ -87,17 +88,17 @@ Bytes oversized() {
 
 INSTANTIATE_TEST_SUITE_P(
     Frames, XsensFrameMalformed,
-    ::testing::Values(BadFrame{"Empty", {}, Error::TooShort}, BadFrame{"OnlyPreamble", {0xFA}, Error::TooShort},
-                      BadFrame{"NoBusId", {0xFA, 0x01, 0x30, 0x00, 0xD1}, Error::BadPreamble},
-                      BadFrame{"NotAPreamble", {0xFB, 0xFF, 0x30, 0x00, 0xD1}, Error::BadPreamble},
-                      BadFrame{"HeaderOnly", {0xFA, 0xFF, 0x30}, Error::TooShort},
-                      BadFrame{"PayloadCut", {0xFA, 0xFF, 0x36, 0x04, 0x10, 0x20}, Error::TooShort},
-                      BadFrame{"ChecksumMissing", {0xFA, 0xFF, 0x30, 0x00}, Error::TooShort},
-                      BadFrame{"ExtendedLengthCut", {0xFA, 0xFF, 0x36, 0xFF, 0x01}, Error::TooShort},
-                      BadFrame{"BadChecksum", {0xFA, 0xFF, 0x30, 0x00, 0xD2}, Error::BadChecksum},
-                      BadFrame{"FlippedPayloadBit", {0xFA, 0xFF, 0x03, 0x04, 0x03, 0x71, 0x03, 0xF8, 0x8C},
-                               Error::BadChecksum},
-                      BadFrame{"LengthOverTheCap", oversized(), Error::TooLong}),
+    ::testing::Values(
+        BadFrame{"Empty", {}, Error::TooShort}, BadFrame{"OnlyPreamble", {0xFA}, Error::TooShort},
+        BadFrame{"NoBusId", {0xFA, 0x01, 0x30, 0x00, 0xD1}, Error::BadPreamble},
+        BadFrame{"NotAPreamble", {0xFB, 0xFF, 0x30, 0x00, 0xD1}, Error::BadPreamble},
+        BadFrame{"HeaderOnly", {0xFA, 0xFF, 0x30}, Error::TooShort},
+        BadFrame{"PayloadCut", {0xFA, 0xFF, 0x36, 0x04, 0x10, 0x20}, Error::TooShort},
+        BadFrame{"ChecksumMissing", {0xFA, 0xFF, 0x30, 0x00}, Error::TooShort},
+        BadFrame{"ExtendedLengthCut", {0xFA, 0xFF, 0x36, 0xFF, 0x01}, Error::TooShort},
+        BadFrame{"BadChecksum", {0xFA, 0xFF, 0x30, 0x00, 0xD2}, Error::BadChecksum},
+        BadFrame{"FlippedPayloadBit", {0xFA, 0xFF, 0x03, 0x04, 0x03, 0x71, 0x03, 0xF8, 0x8C}, Error::BadChecksum},
+        BadFrame{"LengthOverTheCap", oversized(), Error::TooLong}),
     [](const auto& tp) { return std::string(tp.param.name); });
 
 }  // namespace

@@ -38,9 +38,10 @@ Bytes cat(std::initializer_list<Bytes> parts) {
 
 // A small MTData2 message with the given packet counter.
 Bytes counter_frame(std::uint16_t counter) {
-  return encode_frame(mid::kMtData2, cat({packet(0x1020, {static_cast<std::uint8_t>(counter >> 8),
-                                                           static_cast<std::uint8_t>(counter & 0xFF)}),
-                                          packet(0x1060, {0, 0, 0x10, 0x00})}));
+  return encode_frame(
+      mid::kMtData2,
+      cat({packet(0x1020, {static_cast<std::uint8_t>(counter >> 8), static_cast<std::uint8_t>(counter & 0xFF)}),
+           packet(0x1060, {0, 0, 0x10, 0x00})}));
 }
 
 struct Result {
@@ -174,16 +175,16 @@ INSTANTIATE_TEST_SUITE_P(
         Damage{"GarbageBeforeThePreamble", {0x00, 0x01, 0xFA, 0x02, 0xFF, 0x36}, &StreamCounters::garbage_bytes, 6},
         Damage{"TruncatedFrame", {0xFA, 0xFF, 0x36, 0x05, 0x10, 0x20}, &StreamCounters::bad_checksum, 1},
         Damage{"LengthOverTheCap", {0xFA, 0xFF, 0x36, 0xFF, 0xFF, 0xFF}, &StreamCounters::too_long, 1},
-        Damage{"ExtendedLengthMessage", encode_frame(mid::kMtData2, cat({packet(0x1020, {0, 50}),
-                                                                         packet(0xA080, Bytes(250, 1)),
-                                                                         packet(0xA080, Bytes(250, 2))})),
+        Damage{"ExtendedLengthMessage",
+               encode_frame(mid::kMtData2, cat({packet(0x1020, {0, 50}), packet(0xA080, Bytes(250, 1)),
+                                                packet(0xA080, Bytes(250, 2))})),
                &StreamCounters::unknown_data_ids, 2, 1},
         Damage{"WrongSizeForADataId", encode_frame(mid::kMtData2, packet(0x2030, Bytes(8, 0))),
                &StreamCounters::bad_packet_size, 1},
         Damage{"PacketRunsPastThePayload", encode_frame(mid::kMtData2, Bytes{0x10, 0x20, 0x09, 0x00}),
                &StreamCounters::truncated_packet, 1},
-        Damage{"UnknownDataIdsSkipped", encode_frame(mid::kMtData2, cat({packet(0x1020, {0, 150}),
-                                                                         packet(0x7777, {1, 2, 3})})),
+        Damage{"UnknownDataIdsSkipped",
+               encode_frame(mid::kMtData2, cat({packet(0x1020, {0, 150}), packet(0x7777, {1, 2, 3})})),
                &StreamCounters::unknown_data_ids, 1, 1}),
     [](const auto& tp) { return std::string(tp.param.name); });
 

@@ -17,7 +17,7 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr std::int64_t kT0 = 1'718'449'170'000'000'000;  // 2024-06-15 10:59:30 UTC
-constexpr int kZone = 39;                                 // 3-degree zone of CM 117 E (Beijing)
+constexpr int kZone = 39;                                // 3-degree zone of CM 117 E (Beijing)
 constexpr double kGeoidSep = -8.5;
 
 Stamp at_s(double s) { return Stamp{kT0 + std::llround(s * 1e9)}; }
@@ -59,7 +59,8 @@ struct Truth {
   // Where a world point should come out: the detection frame of t_ref.
   [[nodiscard]] Eigen::Vector3d expected(const Eigen::Vector3d& w, double t_ref, const Mounting& lidar) const {
     const double yaw = horizontal_yaw_rad(q());
-    return Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()) * (w - p(t_ref)) - Eigen::Vector3d(lidar.x_m, lidar.y_m, lidar.z_m);
+    return Eigen::AngleAxisd(-yaw, Eigen::Vector3d::UnitZ()) * (w - p(t_ref)) -
+           Eigen::Vector3d(lidar.x_m, lidar.y_m, lidar.z_m);
   }
 };
 
@@ -419,9 +420,9 @@ TEST(FrameCompensator, GnssQualityIsRankedByPrecisionNotByCode) {
     int quality;
     bool fixed_only, float_or_fixed, any;
   };
-  for (const Case c : {Case{1, false, false, true}, Case{2, false, false, true}, Case{4, true, true, true},
-                       Case{5, false, true, true}, Case{6, false, false, false}, Case{7, false, false, false},
-                       Case{8, false, false, false}}) {
+  for (const Case c :
+       {Case{1, false, false, true}, Case{2, false, false, true}, Case{4, true, true, true}, Case{5, false, true, true},
+        Case{6, false, false, false}, Case{7, false, false, false}, Case{8, false, false, false}}) {
     o.gnss_quality = c.quality;
     const sync::SyncedFrame f = make_frame(truth, rtk, o);
     fixed_only.compensate(f, out);
@@ -594,7 +595,8 @@ TEST(FrameCompensator, PlaneOutputOnRequest) {
   truth.pitch_deg = 2.0;
   sync::SyncedFrame f = make_frame(truth, params);
   const auto w = world_points(truth, 50);
-  for (std::size_t i = 0; i < w.size(); ++i) f.points.push_back(truth.seen(w[i], 0.004 * static_cast<double>(i), params.lidar));
+  for (std::size_t i = 0; i < w.size(); ++i)
+    f.points.push_back(truth.seen(w[i], 0.004 * static_cast<double>(i), params.lidar));
   sync::TimedScan s;
   s.time = at_s(0.05);
   s.scan.first_step = 0;
@@ -652,7 +654,8 @@ TEST(FrameCompensator, ValidateRejectsBadParameters) {
       {"antenna_m", [](CompensationParams& p) { p.antenna_m.x() = std::numeric_limits<double>::quiet_NaN(); }},
       {"antenna_m", [](CompensationParams& p) { p.antenna_m.z() = 50.0; }},
       {"lidar mounting", [](CompensationParams& p) { p.lidar.z_m = std::numeric_limits<double>::infinity(); }},
-      {"scan2d mounting", [](CompensationParams& p) { p.scanner.pitch_deg = std::numeric_limits<double>::quiet_NaN(); }},
+      {"scan2d mounting",
+       [](CompensationParams& p) { p.scanner.pitch_deg = std::numeric_limits<double>::quiet_NaN(); }},
       {"pose_step_s", [](CompensationParams& p) { p.pose_step_s = -1.0; }},
       {"turn_period_s", [](CompensationParams& p) { p.scan_turn_period_s = 0.0; }},
       {"scan_geometry", [](CompensationParams& p) { p.scan_geometry.steps_per_turn = 0.0; }},

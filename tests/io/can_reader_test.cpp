@@ -1,18 +1,17 @@
 // CanReader: CAN frames from a socket on the io thread, filtered by id. A socketpair carrying struct can_frame
 // stands in for the CAN_RAW socket (the kernel here has no SocketCAN).
+#include "fieldguard/io/can_reader.hpp"
+
+#include <gtest/gtest.h>
 #include <linux/can.h>
 #include <linux/can/error.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <gtest/gtest.h>
-
 #include <boost/asio/io_context.hpp>
 #include <chrono>
 #include <cstdint>
 #include <vector>
-
-#include "fieldguard/io/can_reader.hpp"
 
 namespace fieldguard::io {
 namespace {
@@ -45,13 +44,13 @@ TEST(CanReader, HandsOverOnlyExtendedFramesItsFiltersPassAndCountsTheRest) {
                    });
   reader.start();
   send_frame(sv[1], kCcvs1FromEngine | CAN_EFF_FLAG, {0xFF, 0x00, 0x0A, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF});
-  send_frame(sv[1], 0x0CFEF117 | CAN_EFF_FLAG, {1, 2, 3});                        // same PGN, other sender
-  send_frame(sv[1], 0x18FEF000 | CAN_EFF_FLAG, {0});                              // another PGN
-  send_frame(sv[1], 0x123, {0});                                                  // standard 11-bit frame
-  send_frame(sv[1], kCcvs1FromEngine | CAN_EFF_FLAG | CAN_RTR_FLAG, {});          // remote request
-  send_frame(sv[1], CAN_ERR_FLAG | CAN_ERR_BUSOFF, {0, 0, 0, 0, 0, 0, 0, 0});     // error frame
+  send_frame(sv[1], 0x0CFEF117 | CAN_EFF_FLAG, {1, 2, 3});                     // same PGN, other sender
+  send_frame(sv[1], 0x18FEF000 | CAN_EFF_FLAG, {0});                           // another PGN
+  send_frame(sv[1], 0x123, {0});                                               // standard 11-bit frame
+  send_frame(sv[1], kCcvs1FromEngine | CAN_EFF_FLAG | CAN_RTR_FLAG, {});       // remote request
+  send_frame(sv[1], CAN_ERR_FLAG | CAN_ERR_BUSOFF, {0, 0, 0, 0, 0, 0, 0, 0});  // error frame
   const std::uint8_t half[5] = {1, 2, 3, 4, 5};
-  ASSERT_EQ(::send(sv[1], half, sizeof half, 0), 5);                              // not a can_frame
+  ASSERT_EQ(::send(sv[1], half, sizeof half, 0), 5);  // not a can_frame
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
   while (reader.stats().frames + reader.stats().not_ours + reader.stats().bad_size < 7 &&
          std::chrono::steady_clock::now() < end) {
@@ -78,7 +77,8 @@ TEST(CanReader, NoFiltersPassNothing) {
   reader.start();
   send_frame(sv[1], kCcvs1FromEngine | CAN_EFF_FLAG, {0, 0, 0});
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (reader.stats().not_ours == 0 && std::chrono::steady_clock::now() < end) io.run_for(std::chrono::milliseconds(20));
+  while (reader.stats().not_ours == 0 && std::chrono::steady_clock::now() < end)
+    io.run_for(std::chrono::milliseconds(20));
   EXPECT_EQ(calls, 0);
   EXPECT_EQ(reader.stats().not_ours, 1U);
   ::close(sv[1]);

@@ -2,11 +2,10 @@
 // the drivers' own stream parsers, at the rates asked, with clocks that only run forward, bytes at the baud
 // rate, and no backlog for a late reader.
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <poll.h>
 #include <signal.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
@@ -49,8 +48,10 @@ void read_for(int gnss, int ahrs, double seconds, OnGnss on_gnss, OnAhrs on_ahrs
       const ssize_t n = ::read(fds[i].fd, buf.data(), buf.size());
       if (n <= 0) continue;
       const ByteSpan bytes(buf.data(), static_cast<std::size_t>(n));
-      if (i == 0) on_gnss(bytes, Clock::now());
-      else on_ahrs(bytes, Clock::now());
+      if (i == 0)
+        on_gnss(bytes, Clock::now());
+      else
+        on_ahrs(bytes, Clock::now());
     }
   }
 }
@@ -266,12 +267,12 @@ TEST(NavEmulator, DurationEndsItAndBadCommandLinesExitTwo) {
     EXPECT_FALSE(fs::exists(fs::symlink_status(dir / "gnss")));
     fs::remove_all(dir);
   }
-  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
-           {"--ahrs-baud", "9600"},                   // 100 x 32 bytes a second need 32000 baud
-           {"--gnss-baud", "1200"},                   // 10 epochs of ~190 bytes need 19000 baud
-           {"--gnss-rate", "fast"},
-           {"--lat", "95"},
-           {"--bogus"}}) {
+  for (const std::vector<std::string>& args :
+       std::vector<std::vector<std::string>>{{"--ahrs-baud", "9600"},  // 100 x 32 bytes a second need 32000 baud
+                                             {"--gnss-baud", "1200"},  // 10 epochs of ~190 bytes need 19000 baud
+                                             {"--gnss-rate", "fast"},
+                                             {"--lat", "95"},
+                                             {"--bogus"}}) {
     std::vector<std::string> argv{FIELDGUARD_NAV_EMULATOR};
     argv.insert(argv.end(), args.begin(), args.end());
     testing::ChildProcess emu(argv);

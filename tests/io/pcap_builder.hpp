@@ -57,7 +57,7 @@ struct Ipv4Udp {
   std::uint16_t src_port = 2368;
   std::uint16_t dst_port = 2368;
   Bytes payload;
-  Bytes ip_options;                      // a multiple of 4 bytes, up to 40
+  Bytes ip_options;  // a multiple of 4 bytes, up to 40
   std::uint8_t version = 4;
   std::uint8_t protocol = 17;
   std::uint16_t flags_fragment = 0x4000;  // DF, offset 0
@@ -71,13 +71,13 @@ inline Bytes build(const Ipv4Udp& d) {
   const auto udp_len = static_cast<std::uint16_t>(8 + d.payload.size());
   Bytes b;
   b.push_back(static_cast<std::uint8_t>((d.version << 4) | d.ihl.value_or(static_cast<std::uint8_t>(header_len / 4))));
-  b.push_back(0);                                               // DSCP/ECN
+  b.push_back(0);  // DSCP/ECN
   put_u16(b, d.total_length.value_or(static_cast<std::uint16_t>(header_len + udp_len)));
-  put_u16(b, 0x1234);                                           // identification
+  put_u16(b, 0x1234);  // identification
   put_u16(b, d.flags_fragment);
-  b.push_back(64);                                              // TTL
+  b.push_back(64);  // TTL
   b.push_back(d.protocol);
-  put_u16(b, 0);                                                // checksum, filled in below
+  put_u16(b, 0);  // checksum, filled in below
   put_u32(b, d.src_ip);
   put_u32(b, d.dst_ip);
   append(b, d.ip_options);
@@ -112,9 +112,9 @@ inline Bytes ethernet(const Bytes& l3, std::uint16_t ethertype = 0x0800,
 // Linux cooked capture v1 (LINKTYPE_LINUX_SLL, 16 bytes): protocol at 14.
 inline Bytes linux_sll(const Bytes& l3, std::uint16_t protocol = 0x0800) {
   Bytes b;
-  put_u16(b, 0);       // packet type: to us
-  put_u16(b, 1);       // ARPHRD_ETHER
-  put_u16(b, 6);       // address length
+  put_u16(b, 0);  // packet type: to us
+  put_u16(b, 1);  // ARPHRD_ETHER
+  put_u16(b, 6);  // address length
   append(b, Bytes{0x60, 0x76, 0x88, 0x20, 0x12, 0x6E, 0, 0});
   put_u16(b, protocol);
   append(b, l3);
@@ -125,11 +125,11 @@ inline Bytes linux_sll(const Bytes& l3, std::uint16_t protocol = 0x0800) {
 inline Bytes linux_sll2(const Bytes& l3, std::uint16_t protocol = 0x0800) {
   Bytes b;
   put_u16(b, protocol);
-  put_u16(b, 0);       // reserved
-  put_u32(b, 2);       // interface index
-  put_u16(b, 1);       // ARPHRD_ETHER
-  b.push_back(0);      // packet type
-  b.push_back(6);      // address length
+  put_u16(b, 0);   // reserved
+  put_u32(b, 2);   // interface index
+  put_u16(b, 1);   // ARPHRD_ETHER
+  b.push_back(0);  // packet type
+  b.push_back(6);  // address length
   append(b, Bytes{0x60, 0x76, 0x88, 0x20, 0x12, 0x6E, 0, 0});
   append(b, l3);
   return b;

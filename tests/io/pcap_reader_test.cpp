@@ -81,7 +81,8 @@ std::vector<OpenErrorCase> open_error_cases() {
   return {
       {"empty", {}, " is empty: not a pcap or pcapng file"},
       {"three_bytes", {0xD4, 0xC3, 0xB2}, " is too short to be a pcap or pcapng file (3 bytes)"},
-      {"elf", {0x7F, 'E', 'L', 'F', 2, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+      {"elf",
+       {0x7F, 'E', 'L', 'F', 2, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
        " is not a pcap or pcapng file (magic 0x7f454c46)"},
       {"text", Bytes(40, 'x'), " is not a pcap or pcapng file (magic 0x78787878)"},
       {"pcap_header_12_of_24", head(pcap, 12),
@@ -92,8 +93,7 @@ std::vector<OpenErrorCase> open_error_cases() {
        " is cut short inside its file header (10 bytes of a pcapng section header)"},
       {"pcapng_idb_cut", head(pcapng, 28 + 10),
        " is cut short inside its file header (truncated pcapng dump file; tried to read "},
-      {"pcapng_without_interface", Pcapng().bytes(),
-       ": the capture file has no Interface Description Blocks"},
+      {"pcapng_without_interface", Pcapng().bytes(), ": the capture file has no Interface Description Blocks"},
       {"pcapng_bad_byte_order_magic", bad_bom,
        " is not a readable pcapng file: bad byte-order magic in its section header"},
   };
@@ -139,8 +139,8 @@ TEST_P(PcapReaderClassic, DecodesEveryRecordWithItsTime) {
   EXPECT_EQ(r.link_type(), kLinkEthernet);
   // µs files lose the sub-microsecond digits; ns files keep them exactly.
   const auto t = [&](std::int64_t ns) { return nanosecond ? ns : ns / 1000 * 1000; };
-  EXPECT_EQ(drain(r), (std::vector<Seen>{{2368, 1206, t(kT0)}, {8308, 512, t(kT0 + 553'001)},
-                                         {2368, 1206, t(kT0 + 1'106'999)}}));
+  EXPECT_EQ(drain(r),
+            (std::vector<Seen>{{2368, 1206, t(kT0)}, {8308, 512, t(kT0 + 553'001)}, {2368, 1206, t(kT0 + 1'106'999)}}));
   EXPECT_EQ(r.stats().records, 3U);
   EXPECT_EQ(r.stats().datagrams, 3U);
   EXPECT_FALSE(r.stats().truncated);
@@ -212,14 +212,14 @@ TEST(PcapReaderRecords, EveryDropKindIsCountedAndReadingGoesOn) {
   bad_ip.ihl = 4;
   ClassicPcap file;
   file.add(eth(2368, 1206), kT0)
-      .add(testing::ethernet(Bytes(28, 0), 0x0806), kT0)                 // ARP
-      .add(testing::ethernet(datagram(2368, 10), 0x86DD), kT0)           // IPv6 EtherType
-      .add(testing::ethernet(testing::build(tcp)), kT0)                  // TCP
-      .add(testing::ethernet(testing::build(fragment)), kT0)             // first fragment
-      .add(testing::ethernet(testing::build(bad_udp)), kT0)              // UDP length 7
-      .add(testing::ethernet(testing::build(bad_ip)), kT0)               // IHL 4
-      .add(Bytes(10, 0), kT0)                                            // shorter than Ethernet
-      .add(head(eth(2368, 1206), 100), kT0, 1248)                        // snaplen cut
+      .add(testing::ethernet(Bytes(28, 0), 0x0806), kT0)        // ARP
+      .add(testing::ethernet(datagram(2368, 10), 0x86DD), kT0)  // IPv6 EtherType
+      .add(testing::ethernet(testing::build(tcp)), kT0)         // TCP
+      .add(testing::ethernet(testing::build(fragment)), kT0)    // first fragment
+      .add(testing::ethernet(testing::build(bad_udp)), kT0)     // UDP length 7
+      .add(testing::ethernet(testing::build(bad_ip)), kT0)      // IHL 4
+      .add(Bytes(10, 0), kT0)                                   // shorter than Ethernet
+      .add(head(eth(2368, 1206), 100), kT0, 1248)               // snaplen cut
       .add(eth(8308, 512), kT0);
   TempDir dir;
   PcapReader r = open_ok(dir.write("mixed.pcap", file.bytes()));

@@ -81,7 +81,6 @@ TEST(PcapReaderPcapngBlocks, InterfaceOfAnotherLinkTypeStopsLibpcap) {
   EXPECT_EQ(r.stats().read_error, "an interface has a type 113 different from the type of the first interface");
 }
 
-
 TEST(PcapReaderTruncatedPcapng, LastBlockCut) {
   Pcapng file;
   file.interface(1).enhanced(0, 1'700'000'000'000'000, eth(2368, 1206));
@@ -93,7 +92,6 @@ TEST(PcapReaderTruncatedPcapng, LastBlockCut) {
   EXPECT_TRUE(r.stats().truncated);
   EXPECT_EQ(r.stats().read_error, "");
 }
-
 
 }  // namespace
 }  // namespace fieldguard::io

@@ -21,10 +21,11 @@ using namespace std::chrono_literals;
 // The emulator as a process; its first line of output is its port. Ended with the test.
 class Emulator {
  public:
-  explicit Emulator(std::vector<std::string> args) : child_([&] {
-    args.insert(args.begin(), FIELDGUARD_SCIP_EMULATOR);
-    return args;
-  }()) {
+  explicit Emulator(std::vector<std::string> args)
+      : child_([&] {
+          args.insert(args.begin(), FIELDGUARD_SCIP_EMULATOR);
+          return args;
+        }()) {
     port_ = static_cast<std::uint16_t>(std::atoi(child_.line().c_str()));
   }
   [[nodiscard]] std::uint16_t port() const { return port_; }
@@ -70,7 +71,8 @@ TEST(ScipSource, StartsUpAndStreamsTheObstacleInFront) {
     geometry = g;
   });
   src.start();
-  ASSERT_TRUE(run_until(io, [&] { return c.scans.size() >= 20; }, 5000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return c.scans.size() >= 20; }, 5000ms));
   EXPECT_EQ(src.protocol_state(), scip::ClientState::Streaming);
   const scip::Scan& s = c.scans.back();
   ASSERT_EQ(s.ranges_mm.size(), 1081U);
@@ -91,10 +93,12 @@ TEST(ScipSource, ConnectionDroppedMidScanIsMadeAgain) {
   ASSERT_NE(emu.port(), 0);
   boost::asio::io_context io;
   Collected c;
-  ScipSource src(io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); },
-                 [&](const std::string& w) { c.states.push_back(w); });
+  ScipSource src(
+      io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); },
+      [&](const std::string& w) { c.states.push_back(w); });
   src.start();
-  ASSERT_TRUE(run_until(io, [&] { return src.link().connects.load() >= 2 && c.scans.size() >= 7; }, 8000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return src.link().connects.load() >= 2 && c.scans.size() >= 7; }, 8000ms));
   EXPECT_GE(src.link().disconnects.load(), 1U);
   for (const auto& s : c.scans) EXPECT_EQ(s.ranges_mm.size(), 1081U);  // the half scan never came out
   bool said_closed = false;
@@ -108,9 +112,11 @@ TEST(ScipSource, GarbageIsCountedAndScansGoOn) {
   ASSERT_NE(emu.port(), 0);
   boost::asio::io_context io;
   Collected c;
-  ScipSource src(io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); });
+  ScipSource src(io, options(emu.port()),
+                 [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); });
   src.start();
-  ASSERT_TRUE(run_until(io, [&] { return c.scans.size() >= 15; }, 8000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return c.scans.size() >= 15; }, 8000ms));
   EXPECT_GT(src.stats().parser_errors.load(), 0U);
   for (const auto& s : c.scans) EXPECT_EQ(s.ranges_mm.size(), 1081U);
   src.stop();
@@ -121,10 +127,12 @@ TEST(ScipSource, LaserThatWillNotLightIsReportedAndRetried) {
   ASSERT_NE(emu.port(), 0);
   boost::asio::io_context io;
   Collected c;
-  ScipSource src(io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); },
-                 [&](const std::string& w) { c.states.push_back(w); });
+  ScipSource src(
+      io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); },
+      [&](const std::string& w) { c.states.push_back(w); });
   src.start();
-  ASSERT_TRUE(run_until(io, [&] { return src.stats().refusals.load() >= 2; }, 5000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return src.stats().refusals.load() >= 2; }, 5000ms));
   EXPECT_TRUE(c.scans.empty());
   bool said = false;
   for (const auto& w : c.states) said = said || w.find("refused BM with status 01") != std::string::npos;

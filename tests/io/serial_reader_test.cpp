@@ -50,7 +50,9 @@ struct Pty {
     if (master >= 0) ::close(master);
     slave = master = -1;
   }
-  bool write(const std::string& s) const { return ::write(master, s.data(), s.size()) == static_cast<ssize_t>(s.size()); }
+  bool write(const std::string& s) const {
+    return ::write(master, s.data(), s.size()) == static_cast<ssize_t>(s.size());
+  }
 };
 
 template <typename Pred>
@@ -102,11 +104,12 @@ TEST_P(SerialEmulatorBaud, ReceivesTheWholeStream) {
                   std::to_string(got.size()) + " bytes: " + why + "\n";
       });
   reader.start();
-  const bool whole = run_until(io, [&] { return got.size() >= expected.size(); }, 20s);
+  const bool whole = run_until(
+      io, [&] { return got.size() >= expected.size(); }, 20s);
   const double s = since_start();
   const SerialStats& st = reader.stats();
-  EXPECT_TRUE(whole) << got.size() << " of " << expected.size() << " bytes; reader: " << st.chunks.load()
-                     << " chunks, " << st.opens.load() << " opens, " << st.open_failures.load() << " open failures, "
+  EXPECT_TRUE(whole) << got.size() << " of " << expected.size() << " bytes; reader: " << st.chunks.load() << " chunks, "
+                     << st.opens.load() << " opens, " << st.open_failures.load() << " open failures, "
                      << st.read_errors.load() << " read errors, " << st.silences.load() << " silences; states:\n"
                      << events;
   reader.stop();
@@ -116,8 +119,8 @@ TEST_P(SerialEmulatorBaud, ReceivesTheWholeStream) {
   std::printf("%u baud: %zu bytes in %.2f s (line rate %.0f bytes/s)\n", baud, got.size(), s, baud / 10.0);
   // The first difference, not two 22 kB strings.
   const auto diff = std::mismatch(got.begin(), got.end(), expected.begin(), expected.end());
-  EXPECT_TRUE(got == expected) << "first difference at byte " << (diff.first - got.begin()) << " of "
-                               << expected.size() << " (received " << got.size() << ")";
+  EXPECT_TRUE(got == expected) << "first difference at byte " << (diff.first - got.begin()) << " of " << expected.size()
+                               << " (received " << got.size() << ")";
   EXPECT_EQ(reader.stats().opens.load(), 1U);
 }
 
@@ -132,15 +135,19 @@ TEST(SerialReader, SilenceIsNoticedAndTalkingAgainReopensNothing) {
   SerialOptions o;
   o.device = pty.path;
   o.silence_timeout_s = 0.2;
-  SerialReader reader(io, o, [&](ByteSpan b, Stamp) { got.append(b.begin(), b.end()); },
-                      [&](SerialState s, const std::string& why) { states.emplace_back(s, why); });
+  SerialReader reader(
+      io, o, [&](ByteSpan b, Stamp) { got.append(b.begin(), b.end()); },
+      [&](SerialState s, const std::string& why) { states.emplace_back(s, why); });
   reader.start();
   ASSERT_TRUE(pty.write("$GPGGA,1\r\n"));
-  ASSERT_TRUE(run_until(io, [&] { return got.size() == 10; }, 2000ms));
-  ASSERT_TRUE(run_until(io, [&] { return reader.stats().state.load() == SerialState::Silent; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return got.size() == 10; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return reader.stats().state.load() == SerialState::Silent; }, 2000ms));
   EXPECT_EQ(reader.stats().silences.load(), 1U);
   ASSERT_TRUE(pty.write("$GPGGA,2\r\n"));
-  ASSERT_TRUE(run_until(io, [&] { return got.size() == 20; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return got.size() == 20; }, 2000ms));
   EXPECT_EQ(reader.stats().state.load(), SerialState::Open);
   EXPECT_EQ(reader.stats().opens.load(), 1U);
   ASSERT_GE(states.size(), 3U);
@@ -164,18 +171,23 @@ TEST(SerialReader, ReopensADeviceThatDisappearedAndCameBack) {
   SerialReader reader(io, o, [&](ByteSpan b, Stamp) { got.append(b.begin(), b.end()); });
   reader.start();
   ASSERT_TRUE(first->write("before"));
-  ASSERT_TRUE(run_until(io, [&] { return got == "before"; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return got == "before"; }, 2000ms));
 
   first.reset();  // unplugged: reads fail, the link dangles, reopening fails until it is back
   fs::remove(link);
-  ASSERT_TRUE(run_until(io, [&] { return reader.stats().state.load() == SerialState::Closed; }, 2000ms));
-  ASSERT_TRUE(run_until(io, [&] { return reader.stats().open_failures.load() >= 2; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return reader.stats().state.load() == SerialState::Closed; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return reader.stats().open_failures.load() >= 2; }, 2000ms));
   EXPECT_EQ(reader.stats().read_errors.load(), 1U);
 
   Pty second;
   fs::create_symlink(second.path, link);
   ASSERT_TRUE(second.write("after"));
-  ASSERT_TRUE(run_until(io, [&] { return got == "beforeafter"; }, 3000ms)) << got;
+  ASSERT_TRUE(run_until(
+      io, [&] { return got == "beforeafter"; }, 3000ms))
+      << got;
   EXPECT_EQ(reader.stats().opens.load(), 2U);
   EXPECT_EQ(reader.stats().state.load(), SerialState::Open);
   reader.stop();
@@ -188,9 +200,11 @@ TEST(SerialReader, MissingDeviceIsRetriedAndReported) {
   SerialOptions o;
   o.device = "/dev/fieldguard-no-such-tty";
   o.reopen_interval_s = 0.02;
-  SerialReader reader(io, o, [](ByteSpan, Stamp) {}, [&](SerialState, const std::string& w) { why = w; });
+  SerialReader reader(
+      io, o, [](ByteSpan, Stamp) {}, [&](SerialState, const std::string& w) { why = w; });
   reader.start();
-  ASSERT_TRUE(run_until(io, [&] { return reader.stats().open_failures.load() >= 3; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return reader.stats().open_failures.load() >= 3; }, 2000ms));
   EXPECT_EQ(reader.stats().state.load(), SerialState::Closed);
   EXPECT_NE(why.find("cannot open /dev/fieldguard-no-such-tty"), std::string::npos) << why;
 }

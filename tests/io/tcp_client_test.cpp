@@ -59,7 +59,8 @@ TEST(TcpClient, RefusedThenServerAppearsThenResetThenSilence) {
   self = &client;
   client.start();
   // Nobody listens yet: refused, backing off.
-  ASSERT_TRUE(run_until(io, [&] { return client.stats().connect_failures.load() >= 2; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return client.stats().connect_failures.load() >= 2; }, 2000ms));
   EXPECT_EQ(client.stats().state.load(), TcpState::Backoff);
 
   // A server appears: the client connects, sends its command, receives a reply; then the server resets.
@@ -74,7 +75,7 @@ TEST(TcpClient, RefusedThenServerAppearsThenResetThenSilence) {
       asio::read(s, asio::buffer(cmd));
       server_got.assign(cmd.begin(), cmd.end());
       asio::write(s, asio::buffer(std::string("BM\n00P\n\n")));
-      std::this_thread::sleep_for(200ms);  // let the reply be read before the reset discards it
+      std::this_thread::sleep_for(200ms);                // let the reply be read before the reset discards it
       s.set_option(asio::socket_base::linger(true, 0));  // RST, as a sensor that reboots
     }
     // Second connection: accept and say nothing (silence).
@@ -82,9 +83,13 @@ TEST(TcpClient, RefusedThenServerAppearsThenResetThenSilence) {
     acc.accept(quiet);
     std::this_thread::sleep_for(800ms);
   });
-  ASSERT_TRUE(run_until(io, [&] { return got == "BM\n00P\n\n"; }, 3000ms)) << got;
-  ASSERT_TRUE(run_until(io, [&] { return client.stats().disconnects.load() >= 1; }, 2000ms));
-  ASSERT_TRUE(run_until(io, [&] { return client.stats().silences.load() >= 1; }, 3000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return got == "BM\n00P\n\n"; }, 3000ms))
+      << got;
+  ASSERT_TRUE(run_until(
+      io, [&] { return client.stats().disconnects.load() >= 1; }, 2000ms));
+  ASSERT_TRUE(run_until(
+      io, [&] { return client.stats().silences.load() >= 1; }, 3000ms));
   server.join();
   client.stop();
   EXPECT_EQ(server_got, "BM\n");

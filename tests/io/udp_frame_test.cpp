@@ -189,8 +189,8 @@ std::vector<DropCase> drop_cases() {
                    FrameDrop::TruncatedRecord});
   cases.push_back({"can_socketcan", 227, Bytes(16, 0), 0, FrameDrop::UnsupportedLink});
   cases.push_back({"ethernet_13_bytes", kLinkEthernet, cut(testing::ethernet(ip), 13), 0, FrameDrop::ShortLinkHeader});
-  cases.push_back({"vlan_tag_cut", kLinkEthernet, cut(testing::ethernet(ip, 0x0800, {0x8100}), 17), 0,
-                   FrameDrop::ShortLinkHeader});
+  cases.push_back(
+      {"vlan_tag_cut", kLinkEthernet, cut(testing::ethernet(ip, 0x0800, {0x8100}), 17), 0, FrameDrop::ShortLinkHeader});
   cases.push_back({"inner_tag_cut", kLinkEthernet, cut(testing::ethernet(ip, 0x0800, {0x88A8, 0x8100}), 20), 0,
                    FrameDrop::ShortLinkHeader});
   cases.push_back({"sll_15_bytes", kLinkLinuxSll, cut(testing::linux_sll(ip), 15), 0, FrameDrop::ShortLinkHeader});
@@ -209,8 +209,8 @@ std::vector<DropCase> drop_cases() {
   cases.push_back({"ihl_0", kLinkRaw, testing::build(with([](Ipv4Udp& d) { d.ihl = 0; })), 0, FrameDrop::BadIpHeader});
   cases.push_back({"version_6_in_ipv4_ethertype", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.version = 6; })), 0,
                    FrameDrop::BadIpHeader});
-  cases.push_back({"raw_version_5", kLinkRaw, testing::build(with([](Ipv4Udp& d) { d.version = 5; })), 0,
-                   FrameDrop::BadIpHeader});
+  cases.push_back(
+      {"raw_version_5", kLinkRaw, testing::build(with([](Ipv4Udp& d) { d.version = 5; })), 0, FrameDrop::BadIpHeader});
   cases.push_back({"ip_header_cut", kLinkEthernet, cut(testing::ethernet(ip), 14 + 19), 0, FrameDrop::BadIpHeader});
   cases.push_back({"ihl_past_frame", kLinkRaw, cut(testing::build(with([](Ipv4Udp& d) { d.ihl = 15; })), 40), 0,
                    FrameDrop::BadIpHeader});
@@ -233,15 +233,15 @@ std::vector<DropCase> drop_cases() {
   cases.push_back({"icmp", kLinkRaw, testing::build(with([](Ipv4Udp& d) { d.protocol = 1; })), 0, FrameDrop::NotUdp});
   cases.push_back({"first_fragment", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.flags_fragment = 0x2000; })), 0,
                    FrameDrop::IpFragment});
-  cases.push_back({"middle_fragment", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.flags_fragment = 0x2000 | 185; })),
-                   0, FrameDrop::IpFragment});
+  cases.push_back({"middle_fragment", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.flags_fragment = 0x2000 | 185; })), 0,
+                   FrameDrop::IpFragment});
   cases.push_back({"last_fragment", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.flags_fragment = 185; })), 0,
                    FrameDrop::IpFragment});
   // UDP header.
   cases.push_back({"udp_length_past_ip", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.udp_length = 8 + 17; })), 0,
                    FrameDrop::BadUdpLength});
-  cases.push_back({"udp_length_7", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.udp_length = 7; })), 0,
-                   FrameDrop::BadUdpLength});
+  cases.push_back(
+      {"udp_length_7", kLinkEthernet, eth(with([](Ipv4Udp& d) { d.udp_length = 7; })), 0, FrameDrop::BadUdpLength});
   cases.push_back({"udp_length_0", kLinkRaw, testing::build(with([](Ipv4Udp& d) { d.udp_length = 0; })), 0,
                    FrameDrop::BadUdpLength});
   cases.push_back({"udp_header_cut_by_total_length", kLinkEthernet,

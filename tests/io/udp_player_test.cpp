@@ -1,13 +1,12 @@
 // fieldguard-udp-player, the bench LiDAR of the live-path tests: a capture's datagrams arrive over real UDP
 // on loopback, byte for byte and in order, on the ports --map names, at the capture's pace.
 #include <arpa/inet.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
@@ -159,8 +158,8 @@ TEST(UdpPlayer, LiveTimeStampsDataPacketsWithTheWallClockAcrossLoops) {
 
 TEST(UdpPlayer, SigtermStopsAndStillPrintsTheSummary) {
   Port data;
-  testing::ChildProcess player({FIELDGUARD_UDP_PLAYER, "--pcap", kCapture, "--map",
-                                "2368:" + std::to_string(data.port()), "--loop", "1000000"});
+  testing::ChildProcess player(
+      {FIELDGUARD_UDP_PLAYER, "--pcap", kCapture, "--map", "2368:" + std::to_string(data.port()), "--loop", "1000000"});
   EXPECT_EQ(player.line(), "playing 540 datagrams");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   player.signal(SIGTERM);
@@ -169,13 +168,13 @@ TEST(UdpPlayer, SigtermStopsAndStillPrintsTheSummary) {
 }
 
 TEST(UdpPlayer, BadCommandLinesExitTwo) {
-  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
-           {"--pcap", "/nonexistent.pcap"},
-           {"--pcap", kCapture, "--map", "2368"},
-           {"--pcap", kCapture, "--speed", "fast"},
-           {"--pcap", kCapture, "--host", "localhost.invalid"},
-           {"--pcap", kCapture, "--map", "9999:5000"},  // nothing left to play
-           {"--bogus"}}) {
+  for (const std::vector<std::string>& args :
+       std::vector<std::vector<std::string>>{{"--pcap", "/nonexistent.pcap"},
+                                             {"--pcap", kCapture, "--map", "2368"},
+                                             {"--pcap", kCapture, "--speed", "fast"},
+                                             {"--pcap", kCapture, "--host", "localhost.invalid"},
+                                             {"--pcap", kCapture, "--map", "9999:5000"},  // nothing left to play
+                                             {"--bogus"}}) {
     std::vector<std::string> argv{FIELDGUARD_UDP_PLAYER};
     argv.insert(argv.end(), args.begin(), args.end());
     testing::ChildProcess player(argv);

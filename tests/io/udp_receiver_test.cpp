@@ -80,7 +80,8 @@ TEST(UdpReceiver, HdlLineRateForTenSecondsLosesNothing) {
     sent += tx.send(i, 1206) ? 1U : 0U;
   }
   const auto deadline = Clock::now() + std::chrono::seconds(5);
-  while (rx.stats().datagrams.load() < sent && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  while (rx.stats().datagrams.load() < sent && Clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   io.stop();
   io_thread.join();
 
@@ -124,7 +125,8 @@ TEST(UdpReceiver, KernelDropsAreCounted) {
   io.restart();
   io.run_for(std::chrono::milliseconds(200));
   const auto drops = rx.stats().kernel_drops.load();
-  std::printf("burst %u + 1: received %zu, kernel drops %llu\n", kBurst, received, static_cast<unsigned long long>(drops));
+  std::printf("burst %u + 1: received %zu, kernel drops %llu\n", kBurst, received,
+              static_cast<unsigned long long>(drops));
   EXPECT_GT(drops, 0U);
   EXPECT_EQ(received + drops, kBurst + 1U);
 }

@@ -4,8 +4,8 @@
 
 #include <bit>
 #include <cmath>
-#include <random>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "fieldguard/output/crc8.hpp"

@@ -42,9 +42,8 @@ std::string read_text(const fs::path& p) {
 }
 
 fs::path temp_dir() {
-  fs::path d = fs::temp_directory_path() /
-               ("fieldguard_can_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::path d = fs::temp_directory_path() / ("fieldguard_can_" + std::to_string(::getpid()) + "_" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -57,7 +56,8 @@ TEST(CandumpLine, IsWhatCandumpMinusLWrites) {
   EXPECT_EQ(candump_line(frame(0x18FF1080, {1, 0, 0, 0, 0, 0, 5, 0x3E}), Stamp{1700000000123456000}, "can0"),
             "(1700000000.123456) can0 18FF1080#010000000000053E\n");
   // Seconds zero-padded to 10 digits, microseconds truncated, ids always 8 digits, uppercase hex.
-  EXPECT_EQ(candump_line(frame(0xABC, {0xAB, 0xCD}), Stamp{5'000'999'999}, "vcan1"), "(0000000005.000999) vcan1 00000ABC#ABCD\n");
+  EXPECT_EQ(candump_line(frame(0xABC, {0xAB, 0xCD}), Stamp{5'000'999'999}, "vcan1"),
+            "(0000000005.000999) vcan1 00000ABC#ABCD\n");
   EXPECT_EQ(candump_line(frame(0x1FFFFFFF, {}), Stamp{-7}, "can0"), "(0000000000.000000) can0 1FFFFFFF#\n");
 }
 

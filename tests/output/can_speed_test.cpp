@@ -78,8 +78,9 @@ TEST(CanSpeed, RealTruckCaptureReadsZeroWhileParked) {
 
 // The whole capture, when ../shared/realdata is there: 127 s parked, 1272 CCVS1 frames, all 0 km/h.
 TEST(CanSpeed, WholeRealTruckCaptureWhenPresent) {
-  const std::string path = std::string(FIELDGUARD_SOURCE_DIR) +
-                           "/../shared/realdata/j1939-css-electronics-canedge/j1939_truck_idle_11111111_00000012_00000001.log";
+  const std::string path =
+      std::string(FIELDGUARD_SOURCE_DIR) +
+      "/../shared/realdata/j1939-css-electronics-canedge/j1939_truck_idle_11111111_00000012_00000001.log";
   std::ifstream log(path);
   if (!log) GTEST_SKIP() << "not present: " << path;
   std::string line;

@@ -144,7 +144,8 @@ std::uint64_t raw_value(const Signal& s, std::span<const std::uint8_t> data) {
 double physical_value(const Signal& s, std::span<const std::uint8_t> data) {
   const std::uint64_t raw = raw_value(s, data);
   double v = static_cast<double>(raw);
-  if (s.is_signed && raw >= (std::uint64_t{1} << (s.length - 1))) v = static_cast<double>(raw) - static_cast<double>(std::uint64_t{1} << s.length);
+  if (s.is_signed && raw >= (std::uint64_t{1} << (s.length - 1)))
+    v = static_cast<double>(raw) - static_cast<double>(std::uint64_t{1} << s.length);
   return v * s.factor + s.offset;
 }
 

@@ -88,7 +88,7 @@ namespace {
 using Cloud = pcl::PointCloud<pcl::PointXYZI>;
 using SweepSignature = pcl::HDLGrabber::sig_cb_velodyne_hdl_sweep_point_cloud_xyzi;
 
-constexpr double kToleranceM = 0.01;        // the acceptance criterion: every return within 1 cm
+constexpr double kToleranceM = 0.01;  // the acceptance criterion: every return within 1 cm
 constexpr double kFullTurnCdeg = 36000.0;
 constexpr auto kGrabberDeadline = std::chrono::seconds(10);  // the files play in well under 1 s in real time
 
@@ -103,10 +103,10 @@ std::string read_text(const std::string& path) {
 
 // Firing layout of protocols.md §1.7 / §1.10.
 struct Layout {
-  std::size_t lasers;     // lasers per firing sequence
-  double block_us;        // one block
-  double sequence_us;     // one firing sequence
-  double firing_us;       // between two lasers of a sequence
+  std::size_t lasers;  // lasers per firing sequence
+  double block_us;     // one block
+  double sequence_us;  // one firing sequence
+  double firing_us;    // between two lasers of a sequence
 };
 constexpr Layout kHdl32Layout{32, 46.08, 46.08, 1.152};
 constexpr Layout kVlp16Layout{16, 110.592, 55.296, 2.304};
@@ -120,16 +120,16 @@ double diff_cdeg(double a, double b) { return wrap_cdeg(a - b + kFullTurnCdeg / 
 
 // One non-zero return of the file, read from the packet bytes by this test (not by our decoder).
 struct RawReturn {
-  std::size_t packet = 0;       // index among the 1206-byte data packets
+  std::size_t packet = 0;  // index among the 1206-byte data packets
   std::size_t block = 0;
   std::size_t slot = 0;
-  std::uint16_t raw = 0;        // distance, 2 mm units
+  std::uint16_t raw = 0;  // distance, 2 mm units
   std::uint8_t intensity = 0;
-  double manual_az_cdeg = 0.0;  // azimuth of the firing by protocols.md (block azimuth + interpolation)
-  double pcl_az_cdeg = 0.0;     // azimuth PCL's grabber computes this return at
-  double pcl_cut_az_cdeg = 0.0; // azimuth PCL's sweep cut looks at (HDL: the block's, VLP: pcl_az_cdeg)
-  bool in_our_range = false;    // kept by our decoder's range limits
-  bool pcl_phantom = false;     // raw == 0, yet PCL emits a point (see SlotCorrection)
+  double manual_az_cdeg = 0.0;   // azimuth of the firing by protocols.md (block azimuth + interpolation)
+  double pcl_az_cdeg = 0.0;      // azimuth PCL's grabber computes this return at
+  double pcl_cut_az_cdeg = 0.0;  // azimuth PCL's sweep cut looks at (HDL: the block's, VLP: pcl_az_cdeg)
+  bool in_our_range = false;     // kept by our decoder's range limits
+  bool pcl_phantom = false;      // raw == 0, yet PCL emits a point (see SlotCorrection)
 };
 
 // Per-slot db.xml corrections a test feeds both sides (HDL-32E only; all zero in the real calibration files).
@@ -142,9 +142,9 @@ using SlotCorrections = std::array<SlotCorrection, 32>;
 
 // Appends the non-zero returns of one data packet, in packet order (block by block, slot 0..31), which is the order
 // in which both PCL and our decoder emit them.
-// With corrections: a return lies at its firing's azimuth minus rotCorrection_. That is the Velodyne manuals' definition
-// (HDL-64E, db.xml parameters: "the rotational correction angle for each laser, as viewed from the back of the unit.
-// Positive factors rotate to the left", i.e. toward smaller clockwise azimuths) and what VeloView, ROS
+// With corrections: a return lies at its firing's azimuth minus rotCorrection_. That is the Velodyne manuals'
+// definition (HDL-64E, db.xml parameters: "the rotational correction angle for each laser, as viewed from the back of
+// the unit. Positive factors rotate to the left", i.e. toward smaller clockwise azimuths) and what VeloView, ROS
 // velodyne_pointcloud (cos(a - rot) = cos a cos rot + sin a sin rot) and PCL (azimuth / 100 - azimuthCorrection) do.
 void index_packet(ByteSpan payload, std::size_t packet, velodyne::Model model, const velodyne::StreamOptions& opt,
                   const SlotCorrections& corr, std::vector<RawReturn>& out) {
@@ -190,16 +190,16 @@ void index_packet(ByteSpan payload, std::size_t packet, velodyne::Model model, c
       }
       // The same float arithmetic as our decoder's range check: corrected distance against the limits.
       const float d = static_cast<float>(r.raw) * 0.002F + static_cast<float>(c.dist_m);
-      r.in_our_range = !r.pcl_phantom && d >= static_cast<float>(opt.min_range_m) &&
-                       d <= static_cast<float>(opt.max_range_m);
+      r.in_our_range =
+          !r.pcl_phantom && d >= static_cast<float>(opt.min_range_m) && d <= static_cast<float>(opt.max_range_m);
       out.push_back(r);
     }
   }
 }
 
 struct OurSide {
-  std::vector<RawReturn> returns;           // every non-zero return of the file (and PCL's phantoms, if any)
-  std::vector<LidarFrame> frames;           // our rotations, including both partial ones
+  std::vector<RawReturn> returns;  // every non-zero return of the file (and PCL's phantoms, if any)
+  std::vector<LidarFrame> frames;  // our rotations, including both partial ones
   std::size_t data_packets = 0;
   std::size_t other_datagrams = 0;
   velodyne::StreamCounters counters;
@@ -329,12 +329,12 @@ void compare(const char* name, const OurSide& ours, const std::vector<Cloud::Con
     // fall a few returns apart, but only among the returns of the one block that straddles 0 degrees.
     const std::size_t lo = std::min(pcl_first, ours_first);
     const std::size_t hi = std::max(pcl_first, ours_first);
-    EXPECT_LE(hi - lo, rules.max_returns_apart) << name << ": rotation " << k << " starts " << hi - lo
-                                                << " returns apart";
+    EXPECT_LE(hi - lo, rules.max_returns_apart)
+        << name << ": rotation " << k << " starts " << hi - lo << " returns apart";
     for (std::size_t i = lo; i < hi; ++i) {
       const double from_cut = std::abs(diff_cdeg(raw[i].manual_az_cdeg, 0.0));
-      EXPECT_LE(from_cut, rules.near_cut_cdeg) << name << ": rotation " << k << " boundary differs at a return "
-                                               << from_cut / 100.0 << " deg from the cut";
+      EXPECT_LE(from_cut, rules.near_cut_cdeg)
+          << name << ": rotation " << k << " boundary differs at a return " << from_cut / 100.0 << " deg from the cut";
     }
     if (k == 0) {
       EXPECT_EQ(pcl_first, 0U);
@@ -351,8 +351,7 @@ void compare(const char* name, const OurSide& ours, const std::vector<Cloud::Con
     }
     rotation_log << "  rotation " << k << (whole ? " (whole)  " : " (partial)") << ": PCL " << pcl_end - pcl_first
                  << " points, ours " << ours.frames[k].points.size() << ", starts "
-                 << static_cast<long long>(pcl_first) - static_cast<long long>(ours_first)
-                 << " returns apart\n";
+                 << static_cast<long long>(pcl_first) - static_cast<long long>(ours_first) << " returns apart\n";
   }
   EXPECT_GE(whole_rotations, 1U) << name << ": at least one whole rotation must be compared";
 
@@ -483,7 +482,7 @@ void run_hdl32e(const char* name, const SlotCorrections& corr, const BoundaryRul
   if (any_correction(corr)) {
     for (std::size_t id = 0; id < corr.size(); ++id) {
       set_field(text, id, "rotCorrection_", corr[id].rot_deg);
-      set_field(text, id, "distCorrection_", corr[id].dist_m * 100.0);               // cm
+      set_field(text, id, "distCorrection_", corr[id].dist_m * 100.0);                 // cm
       set_field(text, id, "horizOffsetCorrection_", corr[id].horiz_offset_m * 100.0);  // cm
       if (testing::Test::HasFatalFailure()) return;
     }

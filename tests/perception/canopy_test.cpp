@@ -342,8 +342,7 @@ TEST(CheckCanopySurroundings, TallClustersOwnEvidenceAndOffAreKept) {
     SliceScene sc = slice_scene(true, 1.2F);
     std::vector<std::uint8_t> marks(sc.frame.size(), 0U);
     const FrameSurroundings frame{sc.frame, sc.height, sc.in_frame, marks};
-    EXPECT_EQ(check_canopy(surroundings_on(), sc.s, sc.above, members, meter, &frame, &scratch),
-              Rejection::Kept);
+    EXPECT_EQ(check_canopy(surroundings_on(), sc.s, sc.above, members, meter, &frame, &scratch), Rejection::Kept);
   }
   SliceScene sc = slice_scene(true);
   std::vector<std::uint8_t> marks(sc.frame.size(), 0U);
@@ -372,8 +371,7 @@ TEST(CheckCanopySurroundings, TallClustersOwnEvidenceAndOffAreKept) {
   }
   std::vector<std::uint8_t> box_marks(box.frame.size(), 0U);
   const FrameSurroundings box_frame{box.frame, box.height, box.in_frame, box_marks};
-  EXPECT_EQ(check_canopy(surroundings_on(), box.s, box.above, face, meter, &box_frame, &scratch),
-            Rejection::Kept);
+  EXPECT_EQ(check_canopy(surroundings_on(), box.s, box.above, face, meter, &box_frame, &scratch), Rejection::Kept);
   std::vector<std::uint8_t> wrong(3, 0U);
   const FrameSurroundings bad{sc.frame, sc.height, sc.in_frame, wrong};
   EXPECT_THROW((void)check_canopy(surroundings_on(), sc.s, sc.above, members, meter, &bad, &scratch),

@@ -16,8 +16,8 @@ namespace fieldguard::perception {
 namespace {
 
 using testing::clusters_of;
-using testing::Sets;
 using testing::same_bounds;
+using testing::Sets;
 using testing::sets_of;
 
 // A crown's body: a 4 x 4 x 4 lattice of 0.5 m (x 10..11.5 m, 64 points), and three stray returns behind it.
@@ -226,9 +226,8 @@ TEST(MergeClusters, AsTheMergedSetsInTheOrderOfTheirLowestPoint) {
     }
     const bool in_order = trial % 3 != 0;
     if (in_order) {
-      std::stable_sort(sets.begin(), sets.end(), [](const auto& a, const auto& b) {
-        return !a.empty() && (b.empty() || a.front() < b.front());
-      });
+      std::stable_sort(sets.begin(), sets.end(),
+                       [](const auto& a, const auto& b) { return !a.empty() && (b.empty() || a.front() < b.front()); });
     } else {
       for (std::size_t k = sets.size(); k > 1; --k) std::swap(sets[k - 1], sets[next(static_cast<std::uint32_t>(k))]);
       for (auto& m : sets) {

@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "fieldguard/perception/euclidean_cluster.hpp"
-
 #include "perception/test_clouds.hpp"
 
 namespace fieldguard::perception {
@@ -188,11 +187,11 @@ TEST(ClusterFilter, BoundsGiveTheSummaryBeforeAndAfterAMerge) {
     for (std::uint32_t i = 0; i < n; ++i) {
       sets[std::min(nc - 1, static_cast<std::uint32_t>(rng.uniform(0.F, static_cast<float>(nc))))].push_back(i);
     }
-    std::stable_sort(sets.begin(), sets.end(), [](const auto& a, const auto& b) {
-      return !a.empty() && (b.empty() || a.front() < b.front());
-    });
+    std::stable_sort(sets.begin(), sets.end(),
+                     [](const auto& a, const auto& b) { return !a.empty() && (b.empty() || a.front() < b.front()); });
     Clusters k = testing::clusters_of(sets);
-    const std::span<const std::uint8_t> g = trial % 2 == 0 ? std::span<const std::uint8_t>{guessed} : std::span<const std::uint8_t>{};
+    const std::span<const std::uint8_t> g =
+        trial % 2 == 0 ? std::span<const std::uint8_t>{guessed} : std::span<const std::uint8_t>{};
     bound_clusters(c, h, g, k, bounds);
     ASSERT_EQ(bounds.size(), k.size());
     for (std::size_t j = 0; j < k.size(); ++j) {
@@ -203,9 +202,10 @@ TEST(ClusterFilter, BoundsGiveTheSummaryBeforeAndAfterAMerge) {
     // Every cluster to one of the first three, or kept.
     std::vector<std::uint32_t> target(k.size());
     for (std::size_t j = 0; j < k.size(); ++j) {
-      target[j] = rng.uniform(0.F, 1.F) < 0.5F ? static_cast<std::uint32_t>(j)
-                                                : std::min<std::uint32_t>(static_cast<std::uint32_t>(j),
-                                                                          static_cast<std::uint32_t>(rng.uniform(0.F, 3.F)));
+      target[j] = rng.uniform(0.F, 1.F) < 0.5F
+                      ? static_cast<std::uint32_t>(j)
+                      : std::min<std::uint32_t>(static_cast<std::uint32_t>(j),
+                                                static_cast<std::uint32_t>(rng.uniform(0.F, 3.F)));
     }
     for (std::size_t j = 0; j < k.size(); ++j) target[j] = target[target[j]];
     merge_clusters(target, n, k, of_point, id, scratch);

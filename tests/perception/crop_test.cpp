@@ -197,9 +197,8 @@ TEST(CropBox, CountsTheKeptPointsUpToALimit) {
         if (rng() % 31 == 0) in.back().x = nan;
       }
       // Sorted runs as well: whole fours kept (the vector count), whole fours beyond the limit.
-      if (n > 100) std::sort(in.begin(), in.begin() + 400, [](const LidarPoint& a, const LidarPoint& b) {
-          return a.x < b.x;
-        });
+      if (n > 100)
+        std::sort(in.begin(), in.begin() + 400, [](const LidarPoint& a, const LidarPoint& b) { return a.x < b.x; });
       Cloud expected;
       std::vector<LidarPoint> expected2d;
       crop_box(in, roi, kBody, expected, expected2d);

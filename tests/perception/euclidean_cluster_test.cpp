@@ -487,9 +487,9 @@ TEST(EuclideanClusterer, GridColumnLookReachesTheStencilsLowestCell) {
     const float w = 0.9F * edge;           // p's offset from q and a on x and on y
     Cloud c;
     c.push_back(2.F, 0.F, bottom - cap + 2.F * s);  // q
-    c.push_back(2.F + w, w, bottom - s);             // p
-    c.push_back(2.F, 0.F, bottom + s);               // a
-    c.push_back(20.F, 0.F, z0);                      // alone
+    c.push_back(2.F + w, w, bottom - s);            // p
+    c.push_back(2.F, 0.F, bottom + s);              // a
+    c.push_back(20.F, 0.F, z0);                     // alone
     // Whether two points join at the cap, as the pair tests compute it.
     const auto joins = [&](std::size_t m, std::size_t n) {
       const float dx = c.x[n] - c.x[m], dy = c.y[n] - c.y[m], dz = c.z[n] - c.z[m];
@@ -499,8 +499,7 @@ TEST(EuclideanClusterer, GridColumnLookReachesTheStencilsLowestCell) {
     const bool all_capped = probe.radius_at(std::sqrt(c.x[0] * c.x[0] + c.z[0] * c.z[0])) == cap;  // q: the nearest
     const bool one_column = cell(c.x[1], 2.F) == 0 && cell(c.y[1], 0.F) == 0;
     const std::int32_t qz = cell(c.z[0], z0), pz = cell(c.z[1], z0), az = cell(c.z[2], z0);
-    if (!all_capped || !one_column || az - qz != reach || az - pz != 1 || !joins(0, 2) || !joins(1, 2) ||
-        joins(0, 1)) {
+    if (!all_capped || !one_column || az - qz != reach || az - pz != 1 || !joins(0, 2) || !joins(1, 2) || joins(0, 1)) {
       continue;
     }
     ++cases;

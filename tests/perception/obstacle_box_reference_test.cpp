@@ -394,8 +394,8 @@ void expect_as_reference(const std::vector<P2>& pts, const char* what, int trial
   EXPECT_TRUE(same_bits(r.center[0], q.center[0]) && same_bits(r.center[1], q.center[1]) &&
               same_bits(r.length_m, q.length_m) && same_bits(r.width_m, q.width_m) && same_bits(r.yaw_rad, q.yaw_rad))
       << what << " " << trial << " (" << pts.size() << " points): " << r.center[0] << ", " << r.center[1] << " "
-      << r.length_m << " x " << r.width_m << " at " << r.yaw_rad << " vs " << q.center[0] << ", " << q.center[1]
-      << " " << q.length_m << " x " << q.width_m << " at " << q.yaw_rad;
+      << r.length_m << " x " << r.width_m << " at " << r.yaw_rad << " vs " << q.center[0] << ", " << q.center[1] << " "
+      << q.length_m << " x " << q.width_m << " at " << q.yaw_rad;
 }
 
 // Sizes around every threshold of the code (64: pre-filter; 256 and 4096: sorts) and beyond.
@@ -468,7 +468,7 @@ TEST(ObstacleBoxReference, LatticesDuplicatesAndSignedZeros) {
     std::vector<P2> pts;
     for (std::size_t i = 0; i < n; ++i) {
       float x = step * std::round(rng.uniform(-cells, cells)), y = step * std::round(rng.uniform(-cells, cells));
-      if (trial % 4 == 1) y = 0.5F * x;  // all on one line
+      if (trial % 4 == 1) y = 0.5F * x;                                             // all on one line
       if (trial % 4 == 2) x = std::copysign(std::fabs(x), rng.uniform(-1.F, 1.F));  // +-0 when zero
       pts.push_back({x, y});
     }

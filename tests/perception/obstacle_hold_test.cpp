@@ -200,7 +200,7 @@ TEST(ObstacleHold, KeepsTheObstaclesNearestFirst) {
 // At 3 m/s the crown comes 0.6 m nearer in 0.2 s: its fragments are beyond the 0.3 m gate unless the speed is
 // given, which grows the gate along x (either way: the bus's speed has no sign) by the distance driven.
 TEST(ObstacleHold, TheGateGrowsAlongXWithTheDistanceDriven) {
-  const std::vector<Fragment> nearer{fragment({14.45F, 8.F, 1.F}, {14.5F, 8.2F, 1.F}, 2)};   // 0.5 m short of it
+  const std::vector<Fragment> nearer{fragment({14.45F, 8.F, 1.F}, {14.5F, 8.2F, 1.F}, 2)};  // 0.5 m short of it
   const std::vector<Fragment> beside{fragment({16.F, 9.45F, 1.F}, {16.1F, 9.5F, 1.F}, 2)};  // 0.45 m off in y
   for (const std::optional<double> speed : {std::optional<double>{}, std::optional<double>{3.0}}) {
     ObstacleHold hold(params());

@@ -134,7 +134,8 @@ TEST(Pipeline, StageTimesAddUpToTheFrame) {
   Pipeline pipe(PipelineParams{});
   const auto before = std::chrono::steady_clock::now();
   const FrameResult r = pipe.process(field_scan());
-  const double outside_us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - before).count();
+  const double outside_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - before).count();
   ASSERT_GT(r.obstacles.size(), 0U);
   const StageTimes& t = r.times;
   for (const float us : {t.crop_us, t.voxel_us, t.ground_us, t.cluster_us, t.merge_us, t.boxes_us}) EXPECT_GT(us, 0.F);
@@ -248,8 +249,8 @@ TEST(Pipeline, GroundBeyondTheRegionOfInterestIsContextOnly) {
   const auto ground_at = [&](float x) { return x <= 38.F ? kFloor : kFloor + kSlope * (x - 38.F); };
   testing::add_plane(c, 0.F, 0.F, kFloor, 2.F, 38.F, -4.F, 4.F, 0.2F);
   testing::add_plane(c, kSlope, 0.F, kFloor - kSlope * 38.F, 50.5F, 60.F, -4.F, 4.F, 0.2F);
-  testing::add_block(c, {49.2F, 1.0F, ground_at(49.2F) + 0.02F}, {3, 4, 4}, 0.1F);       // the clod, 0.3 m
-  testing::add_block(c, {55.F, -1.F, ground_at(55.F) + 0.05F}, {4, 4, 10}, 0.1F);        // a 1 m box beyond
+  testing::add_block(c, {49.2F, 1.0F, ground_at(49.2F) + 0.02F}, {3, 4, 4}, 0.1F);  // the clod, 0.3 m
+  testing::add_block(c, {55.F, -1.F, ground_at(55.F) + 0.05F}, {4, 4, 10}, 0.1F);   // a 1 m box beyond
   const std::vector<LidarPoint> pts = testing::to_lidar(c);
   std::size_t in_roi = 0;
   for (const LidarPoint& p : pts) in_roi += p.x <= 50.F ? 1U : 0U;
@@ -268,7 +269,8 @@ TEST(Pipeline, GroundBeyondTheRegionOfInterestIsContextOnly) {
   with.ground.context_m = 15.0;
   const FrameResult seen = Pipeline(with).process(pts);
   EXPECT_TRUE(seen.obstacles.empty()) << "nearest: " << (seen.obstacles.empty() ? 0.F : seen.obstacles[0].distance_m)
-                                      << " m, " << (seen.obstacles.empty() ? 0.F : seen.obstacles[0].height_above_ground_m)
+                                      << " m, "
+                                      << (seen.obstacles.empty() ? 0.F : seen.obstacles[0].height_above_ground_m)
                                       << " m high";
   EXPECT_EQ(seen.counts.after_roi, in_roi);
   EXPECT_GT(seen.counts.after_voxel, cut.counts.after_voxel) << "the context went into the ground stage";

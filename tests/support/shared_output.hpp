@@ -21,7 +21,8 @@ namespace fieldguard::testing {
 inline std::string stamp_of(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return "missing";
-  return std::to_string(st.st_size) + "-" + std::to_string(st.st_mtim.tv_sec) + "-" + std::to_string(st.st_mtim.tv_nsec);
+  return std::to_string(st.st_size) + "-" + std::to_string(st.st_mtim.tv_sec) + "-" +
+         std::to_string(st.st_mtim.tv_nsec);
 }
 
 // `root/key`, made by `make(dir)` (true when it succeeded) unless it is already there; "" when making failed.

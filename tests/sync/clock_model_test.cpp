@@ -16,7 +16,7 @@ namespace {
 
 TEST(WrapUnwrapper, VelodyneMicrosecondsPastTheHourRollOver) {
   WrapUnwrapper u(kVelodyneMicrosPastHour);
-  u.seed_base(1'000 * 3'600'000'000LL);  // hour 1000 since the epoch
+  u.seed_base(1'000 * 3'600'000'000LL);               // hour 1000 since the epoch
   const std::int64_t a = u.unwrap_ns(3'599'900'000);  // 0.1 s before the top of the hour
   const std::int64_t b = u.unwrap_ns(100'000);        // 0.1 s after it
   EXPECT_EQ(b - a, 200'000'000);

@@ -81,10 +81,12 @@ std::vector<Event> events(const Scenario& sc) {
     for (std::int64_t t = kT0 + sc.scan_offset; t < end; t += 25 * kMs) ev.push_back({t + sc.scan_delay, 1, t, 0});
   }
   if (sc.with_gnss) {
-    for (std::int64_t t = kT0 - 50 * kMs; t < end + 200 * kMs; t += 100 * kMs) ev.push_back({t + sc.gnss_delay, 2, t, 0});
+    for (std::int64_t t = kT0 - 50 * kMs; t < end + 200 * kMs; t += 100 * kMs)
+      ev.push_back({t + sc.gnss_delay, 2, t, 0});
   }
   if (sc.with_ahrs) {
-    for (std::int64_t t = kT0 - 10 * kMs; t < end + 200 * kMs; t += 10 * kMs) ev.push_back({t + sc.ahrs_delay, 3, t, 0});
+    for (std::int64_t t = kT0 - 10 * kMs; t < end + 200 * kMs; t += 10 * kMs)
+      ev.push_back({t + sc.ahrs_delay, 3, t, 0});
   }
   std::stable_sort(ev.begin(), ev.end(), [](const Event& a, const Event& b) { return a.rx < b.rx; });
   return ev;
@@ -287,11 +289,11 @@ TEST(FrameAssembler, PartialRotationIsAFrameOfItsOwnAndALostRotationClosesShort)
   FrameAssembler fa;
   std::vector<SyncedFrame> out;
   const std::int64_t r = 100 * kMs;
-  fa.add_rotation(rotation(0, kT0, r, true));           // stream start: partial
+  fa.add_rotation(rotation(0, kT0, r, true));  // stream start: partial
   fa.add_rotation(rotation(1, kT0 + r, r));
-  fa.add_rotation(rotation(2, kT0 + 2 * r, r));         // completes a 2-rotation window
+  fa.add_rotation(rotation(2, kT0 + 2 * r, r));  // completes a 2-rotation window
   fa.add_rotation(rotation(3, kT0 + 3 * r, r));
-  fa.add_rotation(rotation(5, kT0 + 5 * r, r));         // rotation 4 lost: 3 closes alone, short
+  fa.add_rotation(rotation(5, kT0 + 5 * r, r));  // rotation 4 lost: 3 closes alone, short
   fa.add_rotation(rotation(6, kT0 + 6 * r, r));
   fa.finish(out);
   ASSERT_EQ(out.size(), 4U);

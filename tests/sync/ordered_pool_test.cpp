@@ -8,8 +8,8 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <mutex>
 #include <cstdint>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -126,7 +126,7 @@ FullQueueResult full_queue(DropPolicy policy) {
   pool.submit(make_item(0));
   gate.wait_entered(1);
   for (std::uint64_t i = 1; i < 100; ++i) pool.submit(make_item(i));  // the io thread: never waits
-  pool.poll(sink);  // nothing can be delivered while item 0 is held
+  pool.poll(sink);                                                    // nothing can be delivered while item 0 is held
   EXPECT_TRUE(r.delivered.empty());
   gate.open.store(true);
   pool.stop(Drain::Yes);
@@ -222,8 +222,8 @@ TEST(OrderedPool, ThrowingJobIsReportedInItsPlace) {
   });
   std::vector<Delivered> out;
   const auto sink = [&](const auto& r) {
-    out.push_back({r.ticket, r.input->seq, r.outcome, r.output != nullptr ? *r.output : 0,
-                   r.error != nullptr ? *r.error : ""});
+    out.push_back(
+        {r.ticket, r.input->seq, r.outcome, r.output != nullptr ? *r.output : 0, r.error != nullptr ? *r.error : ""});
   };
   for (std::uint64_t i = 0; i < 200; ++i) {
     Item it = make_item(i);

@@ -46,7 +46,8 @@ struct Rig {
   }
   void scan(std::int64_t t) {
     scip::Scan s;
-    const double local_ms = static_cast<double>(t - kT0) * 1e-6 * (1.0 + 40e-6) + 16'777'000.0;  // wraps at 16 777.216 s
+    const double local_ms =
+        static_cast<double>(t - kT0) * 1e-6 * (1.0 + 40e-6) + 16'777'000.0;  // wraps at 16 777.216 s
     s.timestamp_ms = static_cast<std::uint32_t>(static_cast<std::uint64_t>(local_ms) % (1U << 24));
     sync.push_scan(std::move(s), Stamp{rx(t)});
   }
@@ -59,7 +60,8 @@ struct Rig {
   }
   void ahrs(std::int64_t t) {
     xsens::MtData2 m;
-    const double ticks = static_cast<double>(t - kT0) * 1e-5 * (1.0 - 30e-6) + 4'294'500'000.0;  // wraps at 2^32, 46.7 s in
+    const double ticks =
+        static_cast<double>(t - kT0) * 1e-5 * (1.0 - 30e-6) + 4'294'500'000.0;  // wraps at 2^32, 46.7 s in
     m.sample_time_fine = static_cast<std::uint32_t>(static_cast<std::uint64_t>(ticks) % (1ULL << 32));
     sync.push_ahrs(std::move(m), Stamp{rx(t)});
   }
@@ -135,8 +137,10 @@ TEST(Synchronizer, AcrossTheHourAndEveryCounterWrapFramesKeepComing) {
   std::printf("status at 45 s: %s\n", status_mid.c_str());
   double r_lidar = 0, r_scan = 0, r_gnss = 0, r_ahrs = 0;
   unsigned long long frames = 0, incomplete = 0;
-  ASSERT_EQ(std::sscanf(status_mid.c_str(), "ok | lidar3d %lf Hz, scan2d %lf Hz, gnss %lf Hz, ahrs %lf Hz | frames %llu, incomplete %llu",
-                        &r_lidar, &r_scan, &r_gnss, &r_ahrs, &frames, &incomplete), 6)
+  ASSERT_EQ(std::sscanf(status_mid.c_str(),
+                        "ok | lidar3d %lf Hz, scan2d %lf Hz, gnss %lf Hz, ahrs %lf Hz | frames %llu, incomplete %llu",
+                        &r_lidar, &r_scan, &r_gnss, &r_ahrs, &frames, &incomplete),
+            6)
       << status_mid;
   // Rates over a 2 s window: one sample more or less at its edges.
   EXPECT_NEAR(r_lidar, 10.0, 0.5);
@@ -205,7 +209,7 @@ TEST(Synchronizer, SamplesWithoutTimeAreCounted) {
   xsens::MtData2 m;  // no SampleTimeFine
   sync.push_ahrs(std::move(m), Stamp{kT0});
   sync.push_gnss(nmea::Sentence{nmea::Hdt{}}, Stamp{kT0});  // no fix before it
-  LidarFrame f;  // sensor stamp unknown
+  LidarFrame f;                                             // sensor stamp unknown
   f.host_stamp = Stamp{kT0};
   sync.push_lidar(std::move(f));
   sync.count_decode_errors(SensorKind::Scan2d, 3);

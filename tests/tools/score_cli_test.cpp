@@ -1,7 +1,7 @@
 // fieldguard-score on hand-written frames with known answers.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "tools/tools_test_support.hpp"
@@ -57,8 +57,8 @@ class ScoreCli : public ::testing::Test {
   }
   [[nodiscard]] Json score_json(const std::string& extra = "", const std::string& detections = "det.jsonl",
                                 const std::string& truth = "truth.jsonl") const {
-    const auto r = run(FIELDGUARD_SCORE, "--json --detections " + dir_.file(detections) + " --truth " +
-                                             dir_.file(truth) + extra);
+    const auto r =
+        run(FIELDGUARD_SCORE, "--json --detections " + dir_.file(detections) + " --truth " + dir_.file(truth) + extra);
     EXPECT_EQ(r.exit_code, 0) << r.errors;
     Json parsed = Json::parse(r.output, nullptr, /*allow_exceptions=*/false);
     EXPECT_FALSE(parsed.is_discarded()) << r.output;
@@ -158,16 +158,19 @@ TEST_F(ScoreCli, CrownTruePositivesFalseAndMissed) {
 // visible: nothing that shows that little of itself above terrain height can be told from a clod or a stray
 // return. The old rule (--min-raised-hits 0) counts it, and its miss.
 TEST_F(ScoreCli, ReturnsBelowTerrainHeightDoNotMakeAnObjectVisible) {
-  write_file(dir_.file("raised.truth.jsonl"),
-             R"({"frame": 0, "stamp": 200.0, "period_s": 0.1, "objects": [)"
-             R"({"id": "T", "class": "crown", "min": [20.0, 2.0, -1.0], "max": [22.0, 4.0, 2.0], "hits": 9, "raised_hits": 1},)"
-             R"( {"id": "U", "class": "crown", "min": [20.0, -4.0, -1.0], "max": [22.0, -2.0, 2.0], "hits": 12, "raised_hits": 12},)"
-             R"( {"id": "P", "class": "pedestrian", "min": [30.0, -0.3, -1.0], "max": [30.5, 0.3, 0.8], "hits": 4, "raised_hits": 2, "distance_m": 30.0}]})"
-             "\n");
+  write_file(
+      dir_.file("raised.truth.jsonl"),
+      R"({"frame": 0, "stamp": 200.0, "period_s": 0.1, "objects": [)"
+      R"({"id": "T", "class": "crown", "min": [20.0, 2.0, -1.0], "max": [22.0, 4.0, 2.0], "hits": 9, "raised_hits": 1},)"
+      R"( {"id": "U", "class": "crown", "min": [20.0, -4.0, -1.0], "max": [22.0, -2.0, 2.0], "hits": 12, "raised_hits": 12},)"
+      R"( {"id": "P", "class": "pedestrian", "min": [30.0, -0.3, -1.0], "max": [30.5, 0.3, 0.8], "hits": 4, "raised_hits": 2, "distance_m": 30.0}]})"
+      "\n");
   write_file(dir_.file("raised.det.jsonl"),
              R"({"frame": 0, "stamp": 200.0, "obstacles": [{"min": [20.2, -3.8, 0.5], "max": [21.8, -2.2, 1.9]}]})"
              "\n");
-  const auto score = [&](const std::string& extra) { return score_json(extra, "raised.det.jsonl", "raised.truth.jsonl"); };
+  const auto score = [&](const std::string& extra) {
+    return score_json(extra, "raised.det.jsonl", "raised.truth.jsonl");
+  };
   const Json v = score("");
   EXPECT_EQ(num(v, {"params", "min_raised_hits"}), 3);
   EXPECT_EQ(num(v, {"crowns", "visible"}), 1);
@@ -184,23 +187,27 @@ TEST_F(ScoreCli, ReturnsBelowTerrainHeightDoNotMakeAnObjectVisible) {
 }
 
 TEST_F(ScoreCli, TruthWithoutRaisedHitsIsRefusedUnlessTheOldRuleIsAsked) {
-  write_file(dir_.file("old.truth.jsonl"),
-             R"({"frame": 0, "stamp": 100.0, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 40}]})"
-             "\n");
+  write_file(
+      dir_.file("old.truth.jsonl"),
+      R"({"frame": 0, "stamp": 100.0, "period_s": 0.1, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 40}]})"
+      "\n");
   auto r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("old.truth.jsonl"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("old.truth.jsonl:1: p has no \"raised_hits\""), std::string::npos) << r.errors;
   EXPECT_NE(r.errors.find("--min-raised-hits 0"), std::string::npos) << r.errors;
-  EXPECT_EQ(num(score_json(" --min-raised-hits 0", "det.jsonl", "old.truth.jsonl"), {"classes", "pedestrian", "detected"}),
-            1);
+  EXPECT_EQ(
+      num(score_json(" --min-raised-hits 0", "det.jsonl", "old.truth.jsonl"), {"classes", "pedestrian", "detected"}),
+      1);
 
-  write_file(dir_.file("more.truth.jsonl"),
-             R"({"frame": 0, "stamp": 100.0, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 4, "raised_hits": 5}]})"
-             "\n");
+  write_file(
+      dir_.file("more.truth.jsonl"),
+      R"({"frame": 0, "stamp": 100.0, "objects": [{"id": "p", "class": "pedestrian", "min": [12.0, -0.3, -0.95], "max": [12.5, 0.3, 0.8], "hits": 4, "raised_hits": 5}]})"
+      "\n");
   r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("more.truth.jsonl"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("more.truth.jsonl:1: objects[0]: \"raised_hits\" must be from 0 to \"hits\""),
-            std::string::npos) << r.errors;
+            std::string::npos)
+      << r.errors;
   EXPECT_EQ(run(FIELDGUARD_SCORE, "--detections a --truth b --min-raised-hits -1").exit_code, 2);
 }
 
@@ -211,7 +218,8 @@ TEST_F(ScoreCli, PartialFramesCanBeIncluded) {
 }
 
 TEST_F(ScoreCli, TextReport) {
-  const auto r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("truth.jsonl"));
+  const auto r =
+      run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("truth.jsonl"));
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.output.find("25-30"), std::string::npos);
   EXPECT_NE(r.output.find("true positive 2"), std::string::npos);
@@ -223,7 +231,9 @@ TEST_F(ScoreCli, UnusableInputExitsTwoNamingFileAndLine) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("bad.jsonl:1:"), std::string::npos) << r.errors;
 
-  write_file(dir_.file("bad2.jsonl"), "{\"stamp\": 1.0, \"obstacles\": []}\n{\"stamp\": 1.1, \"obstacles\": [{\"min\": [0, 0], \"max\": [1, 1, 1]}]}\n");
+  write_file(dir_.file("bad2.jsonl"),
+             "{\"stamp\": 1.0, \"obstacles\": []}\n{\"stamp\": 1.1, \"obstacles\": [{\"min\": [0, 0], \"max\": [1, 1, "
+             "1]}]}\n");
   r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("bad2.jsonl") + " --truth " + dir_.file("truth.jsonl"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("bad2.jsonl:2: obstacles[0]"), std::string::npos) << r.errors;
@@ -237,7 +247,8 @@ TEST_F(ScoreCli, UnusableInputExitsTwoNamingFileAndLine) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("nope.jsonl"), std::string::npos);
 
-  write_file(dir_.file("badtruth.jsonl"), "{\"stamp\": 1.0, \"objects\": [{\"min\": [0,0,0], \"max\": [1,1,1], \"hits\": 3}]}\n");
+  write_file(dir_.file("badtruth.jsonl"),
+             "{\"stamp\": 1.0, \"objects\": [{\"min\": [0,0,0], \"max\": [1,1,1], \"hits\": 3}]}\n");
   r = run(FIELDGUARD_SCORE, "--detections " + dir_.file("det.jsonl") + " --truth " + dir_.file("badtruth.jsonl"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.errors.find("badtruth.jsonl:1: objects[0]: \"class\""), std::string::npos) << r.errors;

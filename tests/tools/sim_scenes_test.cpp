@@ -48,13 +48,16 @@ TEST(SimCli, BadCommandLinesExitTwo) {
   const auto help = run(FIELDGUARD_SIM, "--help");
   EXPECT_EQ(help.exit_code, 0);
   for (const SceneInfo& s : scene_catalog()) EXPECT_NE(help.output.find(std::string(s.name)), std::string::npos);
-  EXPECT_EQ(run(FIELDGUARD_SIM, "--scene flat --rotations 1 --quiet --pcap " + dir.file("no/such/dir/x.pcap")).exit_code, 1);
+  EXPECT_EQ(
+      run(FIELDGUARD_SIM, "--scene flat --rotations 1 --quiet --pcap " + dir.file("no/such/dir/x.pcap")).exit_code, 1);
 }
 
 TEST(SimCli, TruthLinesAreWhatTheScorerReads) {
   ScratchDir dir("truth");
-  ASSERT_EQ(run(FIELDGUARD_SIM, "--scene farmyard --rotations 3 --quiet --pcap " + dir.file("f.pcap") +
-                                    " --truth " + dir.file("t.jsonl")).exit_code, 0);
+  ASSERT_EQ(run(FIELDGUARD_SIM, "--scene farmyard --rotations 3 --quiet --pcap " + dir.file("f.pcap") + " --truth " +
+                                    dir.file("t.jsonl"))
+                .exit_code,
+            0);
   std::vector<score::TruthFrame> truth;
   std::string error;
   ASSERT_TRUE(score::read_truth(dir.file("t.jsonl"), truth, error)) << error;

@@ -34,8 +34,8 @@ struct Outcome {
   std::string obstacles;  // the obstacles.jsonl
 };
 
-Outcome sim_replay_score(const std::string& config, const ScratchDir& dir, const std::string& scene = "rough-pedestrian",
-                         int rotations = kRotations) {
+Outcome sim_replay_score(const std::string& config, const ScratchDir& dir,
+                         const std::string& scene = "rough-pedestrian", int rotations = kRotations) {
   Outcome o;
   const std::string pcap = dir.file("scene.pcap");
   const std::string truth = dir.file("scene.truth.jsonl");

@@ -1,16 +1,16 @@
 // fieldguard-sim --session: the GNSS, AHRS and 2D LiDAR streams beside the HDL-32E capture, each decoded by
 // the project's own decoders (nmea::StreamParser, xsens::StreamParser, scip::Session as replay runs them)
 // and held against the simulator's pose truth; the uneven-drive scene's attitude, pole and low box.
-#include <GeographicLib/LocalCartesian.hpp>
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
+#include <GeographicLib/LocalCartesian.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <numeric>
 #include <sstream>
 #include <string>
@@ -88,10 +88,11 @@ class SimSession : public ::testing::Test {
     // One session per build, shared by this suite's test processes (ctest runs each test in its own).
     std::string errors;
     dir_ = new std::string(testing::shared_output(
-        FIELDGUARD_TEST_WORK, "uneven-drive-" + std::to_string(kRotations) + "-seed3-" + testing::stamp_of(FIELDGUARD_SIM),
+        FIELDGUARD_TEST_WORK,
+        "uneven-drive-" + std::to_string(kRotations) + "-seed3-" + testing::stamp_of(FIELDGUARD_SIM),
         [&](const std::string& d) {
           const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --session '" + d + "' --rotations " +
-                                                       std::to_string(kRotations) + " --seed 3 --quiet");
+                                                             std::to_string(kRotations) + " --seed 3 --quiet");
           errors = r.errors;
           return r.exit_code == 0;
         }));
@@ -190,8 +191,10 @@ TEST_F(SimSession, GnssDecodesWithRtkNoiseAt10Hz) {
   const Stats e = stats(east);
   const Stats u = stats(up);
   const Stats h = stats(heading);
-  std::printf("GNSS error over %zu epochs: north %.4f +- %.4f m, east %.4f +- %.4f m, up %.4f +- %.4f m, heading %.3f +- %.3f deg\n",
-              gga.size(), n.mean, n.sd, e.mean, e.sd, u.mean, u.sd, h.mean, h.sd);
+  std::printf(
+      "GNSS error over %zu epochs: north %.4f +- %.4f m, east %.4f +- %.4f m, up %.4f +- %.4f m, heading %.3f +- %.3f "
+      "deg\n",
+      gga.size(), n.mean, n.sd, e.mean, e.sd, u.mean, u.sd, h.mean, h.sd);
   // RTK fixed: about 1 cm a horizontal axis (correlated over seconds: 101 epochs see a part of it).
   for (const Stats& s : {n, e}) {
     EXPECT_LT(std::abs(s.mean), 0.03);
@@ -241,20 +244,23 @@ TEST_F(SimSession, AhrsDecodesAt100HzWithSmallAttitudeNoise) {
     droll.push_back(m->euler_deg->x - num(truth[k], "roll_deg"));
     dpitch.push_back(m->euler_deg->y - num(truth[k], "pitch_deg"));
     dyaw.push_back(m->euler_deg->z - num(truth[k], "yaw_deg"));
-    latency_ms.push_back((static_cast<double>(host[k]) - static_cast<double>(kStartNs) - 1e7 * static_cast<double>(k)) * 1e-6);
+    latency_ms.push_back((static_cast<double>(host[k]) - static_cast<double>(kStartNs) - 1e7 * static_cast<double>(k)) *
+                         1e-6);
   }
   const Stats r = stats(droll);
   const Stats p = stats(dpitch);
   const Stats y = stats(dyaw);
   const Stats l = stats(latency_ms);
-  std::printf("AHRS error over %zu samples: roll %.4f +- %.4f, pitch %.4f +- %.4f, yaw %.4f +- %.4f deg; latency %.2f +- %.2f ms\n",
-              items.size(), r.mean, r.sd, p.mean, p.sd, y.mean, y.sd, l.mean, l.sd);
+  std::printf(
+      "AHRS error over %zu samples: roll %.4f +- %.4f, pitch %.4f +- %.4f, yaw %.4f +- %.4f deg; latency %.2f +- %.2f "
+      "ms\n",
+      items.size(), r.mean, r.sd, p.mean, p.sd, y.mean, y.sd, l.mean, l.sd);
   for (const Stats& s : {r, p, y}) {
     EXPECT_LT(std::abs(s.mean), 0.02);
     EXPECT_GT(s.sd, 0.04);
     EXPECT_LT(s.sd, 0.12);
   }
-  EXPECT_EQ(extra_ticks, 2U);  // 1000 intervals x 100 ticks x 20 ppm
+  EXPECT_EQ(extra_ticks, 2U);                         // 1000 intervals x 100 ticks x 20 ppm
   EXPECT_NEAR(num(truth[0], "yaw_deg"), 30.0, 1e-9);  // path heading 60 deg (compass) = ENU yaw 30 deg
   EXPECT_GT(*std::min_element(latency_ms.begin(), latency_ms.end()), 1.0);
   EXPECT_LT(*std::max_element(latency_ms.begin(), latency_ms.end()), 6.0);
@@ -304,7 +310,8 @@ TEST_F(SimSession, Scan2dSessionDecodesAt40Hz) {
       EXPECT_TRUE(d == 25 || d == 24) << k << ": " << d;
       EXPECT_GT(host[k], host[k - 1]);
     }
-    const double latency_ms = (static_cast<double>(host[k]) - static_cast<double>(kStartNs) - 25e6 * static_cast<double>(k)) * 1e-6;
+    const double latency_ms =
+        (static_cast<double>(host[k]) - static_cast<double>(kStartNs) - 25e6 * static_cast<double>(k)) * 1e-6;
     EXPECT_GT(latency_ms, 18.75);  // sent after the last step
     EXPECT_LT(latency_ms, 22.0);
   }
@@ -334,8 +341,9 @@ TEST_F(SimSession, LowBoxInFrontIsSeenByThe2dScanNotByThe3dLidar) {
     for (const double y : {mn[1], mx[1]}) far = std::max(far, std::hypot(x, y));
   }
   const double beam_z = -far * std::tan(30.67 * kPi / 180.0);
-  std::printf("low box: sensor-frame x %.3f..%.3f, top z %.3f; the lowest beam at its far corner (%.3f m) is at z %.3f\n",
-              mn[0], mx[0], mx[2], far, beam_z);
+  std::printf(
+      "low box: sensor-frame x %.3f..%.3f, top z %.3f; the lowest beam at its far corner (%.3f m) is at z %.3f\n",
+      mn[0], mx[0], mx[2], far, beam_z);
   EXPECT_LT(mx[2], beam_z - 0.1);
   EXPECT_EQ(num(*box, "hits"), 0.0);
 
@@ -353,8 +361,8 @@ TEST_F(SimSession, LowBoxInFrontIsSeenByThe2dScanNotByThe3dLidar) {
     const auto x = static_cast<double>(p.x);
     const auto y = static_cast<double>(p.y);
     const auto z = static_cast<double>(p.z);
-    if (x > mn[0] - 0.1 && x < mx[0] + 0.1 && y > mn[1] - 0.1 && y < mx[1] + 0.1 &&
-        z > mn[2] - 0.1 && z < mx[2] + 0.1) {
+    if (x > mn[0] - 0.1 && x < mx[0] + 0.1 && y > mn[1] - 0.1 && y < mx[1] + 0.1 && z > mn[2] - 0.1 &&
+        z < mx[2] + 0.1) {
       ++in_box;
     }
     if (x > 0.0 && x < 2.5 && std::abs(y) < 1.0) ++ahead_low;
@@ -429,8 +437,8 @@ TEST(SimSessionDeterminism, SameSeedSameBytesOtherSeedOtherNoise) {
   tools_test::ScratchDir dir("session_det");
   for (const char* run : {"a", "b", "c"}) {
     const std::string seed = std::string(run) == "c" ? "8" : "7";
-    const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --rotations 10 --quiet --seed " + seed + " --session '" +
-                                                       dir.file(run) + "'");
+    const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --rotations 10 --quiet --seed " + seed +
+                                                       " --session '" + dir.file(run) + "'");
     ASSERT_EQ(r.exit_code, 0) << r.errors;
   }
   for (const char* f : {"lidar.pcap", "lidar.truth.jsonl", "gnss.log", "ahrs.log", "scan2d.log", "pose.truth.jsonl"}) {
@@ -447,22 +455,26 @@ TEST(SimSessionDeterminism, SameSeedSameBytesOtherSeedOtherNoise) {
 
 TEST(SimSessionCli, BadSessionOptionsAreRefused) {
   tools_test::ScratchDir dir("session_cli");
-  for (const std::string& bad : {std::string("--antenna 1,2"), std::string("--antenna 0,0,99"), std::string("--origin 95,0,0"),
-                                 std::string("--heading 360"), std::string("--heading x")}) {
-    const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --rotations 2 --quiet --session '" + dir.file("x") + "' " + bad);
+  for (const std::string& bad :
+       {std::string("--antenna 1,2"), std::string("--antenna 0,0,99"), std::string("--origin 95,0,0"),
+        std::string("--heading 360"), std::string("--heading x")}) {
+    const auto r = tools_test::run(
+        FIELDGUARD_SIM, "--scene uneven-drive --rotations 2 --quiet --session '" + dir.file("x") + "' " + bad);
     EXPECT_EQ(r.exit_code, 2) << bad;
     EXPECT_NE(r.errors.find(bad.substr(0, bad.find(' '))), std::string::npos) << r.errors;
   }
   // A session directory that cannot be created is a write failure.
   tools_test::write_file(dir.file("file"), "x");
-  const auto r = tools_test::run(FIELDGUARD_SIM, "--scene uneven-drive --rotations 2 --quiet --session '" + dir.file("file/sub") + "'");
+  const auto r = tools_test::run(FIELDGUARD_SIM,
+                                 "--scene uneven-drive --rotations 2 --quiet --session '" + dir.file("file/sub") + "'");
   EXPECT_EQ(r.exit_code, 1);
 }
 
 TEST(SimGeodesy, WorldToGeodeticAgreesWithGeographicLib) {
   const FieldPlacement place({48.1, 11.6, 520.0}, 60.0);
   const GeographicLib::LocalCartesian reference(48.1, 11.6, 520.0);
-  for (const Vec3 w : {Vec3{0.0, 0.0, 0.0}, Vec3{1000.0, 0.0, 0.0}, Vec3{120.0, -45.0, 3.0}, Vec3{-300.0, 800.0, -2.0}}) {
+  for (const Vec3 w :
+       {Vec3{0.0, 0.0, 0.0}, Vec3{1000.0, 0.0, 0.0}, Vec3{120.0, -45.0, 3.0}, Vec3{-300.0, 800.0, -2.0}}) {
     const Vec3 enu = place.enu_of(w);
     double lat = 0.0;
     double lon = 0.0;

@@ -11,7 +11,6 @@
 // Header-only; the target fieldguard_tool_cli (tools/CMakeLists.txt) brings it and CLI11.
 
 #include <CLI/CLI.hpp>
-
 #include <array>
 #include <charconv>
 #include <cstdio>

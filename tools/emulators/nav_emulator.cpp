@@ -16,8 +16,8 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -177,7 +177,8 @@ class Pty {
 };
 
 std::int64_t utc_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 double wrap_deg(double a) {
@@ -219,7 +220,8 @@ fieldguard::tools::AhrsSample ahrs_sample(const Settings& s, std::uint64_t k) {
   a.packet_counter = static_cast<std::uint16_t>(k & 0xFFFFU);
   // The counter is the sensor's own clock: whole ticks of 10 kHz, wrapping at 32 bits.
   a.sample_time_fine = static_cast<std::uint32_t>(
-      (static_cast<std::uint64_t>(s.fine_start) + static_cast<std::uint64_t>(std::llround(t * 10000.0))) & 0xFFFFFFFFULL);
+      (static_cast<std::uint64_t>(s.fine_start) + static_cast<std::uint64_t>(std::llround(t * 10000.0))) &
+      0xFFFFFFFFULL);
   a.roll_deg = 1.0 * std::sin(2.0 * std::numbers::pi * t / 10.0);
   a.pitch_deg = 0.5 * std::sin(2.0 * std::numbers::pi * t / 7.0);
   a.yaw_deg = wrap_deg(90.0 - s.heading_deg);
@@ -239,7 +241,8 @@ void run_gnss(const Settings& s, const Pty& pty, std::int64_t start_utc_ns, Coun
     }
     if (g_stop.load()) return;
     c.started_late(utc_now_ns() - print_at);
-    const std::vector<std::uint8_t> bytes = epoch_bytes(gnss_epoch(s, epoch, static_cast<double>(epoch - start_utc_ns) * 1e-9));
+    const std::vector<std::uint8_t> bytes =
+        epoch_bytes(gnss_epoch(s, epoch, static_cast<double>(epoch - start_utc_ns) * 1e-9));
     pty.drop_unread(c);
     if (!pty.send(bytes.data(), bytes.size(), bytes_per_s, c)) {
       g_stop.store(true);
@@ -287,14 +290,14 @@ int main(int argc, char** argv) {
               "MTData2 messages a second (default 100)")
       ->type_name("HZ");
   const cli::Between<long> baud{300, fieldguard::tools::kMaxBaud};
-  cli::number(app, "--gnss-baud", s.gnss_baud, baud, "line rate of the GNSS (default 115200); the epochs must fit in it")
+  cli::number(app, "--gnss-baud", s.gnss_baud, baud,
+              "line rate of the GNSS (default 115200); the epochs must fit in it")
       ->type_name("N");
   cli::number(app, "--ahrs-baud", s.ahrs_baud, baud, "line rate of the AHRS (default 115200)")->type_name("N");
   cli::number(app, "--lat", s.lat_deg, cli::Between<double>{-89.0, 89.0},
               "latitude where the antenna starts (default 48.1 N: a field north of Munich)")
       ->type_name("DEG");
-  cli::number(app, "--lon", s.lon_deg, cli::Between<double>{-180.0, 180.0},
-              "its longitude (default 11.6 E)")
+  cli::number(app, "--lon", s.lon_deg, cli::Between<double>{-180.0, 180.0}, "its longitude (default 11.6 E)")
       ->type_name("DEG");
   cli::number(app, "--height", s.h_m, cli::Between<double>{-1000.0, 10000.0}, "its ellipsoidal height (default 520)")
       ->type_name("M");
@@ -317,7 +320,8 @@ int main(int argc, char** argv) {
 
   // A sensor configured for more than its line carries would fall ever further behind: refuse it.
   const double gnss_load = static_cast<double>(epoch_bytes(gnss_epoch(s, utc_now_ns(), 0.0)).size()) * s.gnss_rate_hz;
-  const double ahrs_load = static_cast<double>(fieldguard::tools::mtdata2_frame(ahrs_sample(s, 0)).size()) * s.ahrs_rate_hz;
+  const double ahrs_load =
+      static_cast<double>(fieldguard::tools::mtdata2_frame(ahrs_sample(s, 0)).size()) * s.ahrs_rate_hz;
   if (gnss_load > 0.9 * static_cast<double>(s.gnss_baud) / 10.0) {
     return tool.fail("the GNSS epochs need " + std::to_string(static_cast<long>(gnss_load * 10.0)) +
                      " baud, more than 90 % of --gnss-baud " + std::to_string(s.gnss_baud));
@@ -334,7 +338,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fieldguard-nav-emulator: %s\n", error.c_str());
     return 1;
   }
-  struct sigaction sa{};
+  struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   ::sigaction(SIGTERM, &sa, nullptr);
   ::sigaction(SIGINT, &sa, nullptr);
@@ -347,7 +351,8 @@ int main(int argc, char** argv) {
   std::thread gnss_thread(run_gnss, std::cref(s), std::cref(gnss), utc_now_ns(), std::ref(gc));
   std::thread ahrs_thread(run_ahrs, std::cref(s), std::cref(ahrs), std::ref(ac));
   while (!g_stop.load()) {
-    if (s.duration_s > 0.0 && std::chrono::steady_clock::now() - start >= std::chrono::duration<double>(s.duration_s)) break;
+    if (s.duration_s > 0.0 && std::chrono::steady_clock::now() - start >= std::chrono::duration<double>(s.duration_s))
+      break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   g_stop.store(true);

@@ -59,8 +59,9 @@ std::string nmea_time(std::int64_t utc_ns) {
   const std::int64_t cs = utc_ns / 10000000;  // hundredths since the epoch
   const std::int64_t day_cs = cs % 8640000;
   char buf[16];
-  std::snprintf(buf, sizeof buf, "%02d%02d%02d.%02d", static_cast<int>(day_cs / 360000), static_cast<int>(day_cs / 6000 % 60),
-                static_cast<int>(day_cs / 100 % 60), static_cast<int>(day_cs % 100));
+  std::snprintf(buf, sizeof buf, "%02d%02d%02d.%02d", static_cast<int>(day_cs / 360000),
+                static_cast<int>(day_cs / 6000 % 60), static_cast<int>(day_cs / 100 % 60),
+                static_cast<int>(day_cs % 100));
   return buf;
 }
 
@@ -89,11 +90,11 @@ std::vector<std::string> nmea_epoch(const GnssEpoch& e) {
   const std::string lon = nmea_angle(e.lon_deg, 3, 'E', 'W');
   std::vector<std::string> out;
   out.push_back(nmea_sentence("GNGGA," + time + "," + lat + "," + lon + ",4," + std::to_string(e.satellites) + ",0.6," +
-                              fixed_text(3, e.h_m - e.geoid_separation_m) + ",M," + fixed_text(3, e.geoid_separation_m) +
-                              ",M,1.0,0001"));
-  out.push_back(nmea_sentence("GNRMC," + time + ",A," + lat + "," + lon + "," + fixed_text(3, e.speed_mps * 3600.0 / 1852.0) +
-                              "," + (e.course_deg ? fixed_text(2, *e.course_deg) : std::string()) + "," +
-                              nmea_date(e.utc_ns) + ",,,D"));
+                              fixed_text(3, e.h_m - e.geoid_separation_m) + ",M," +
+                              fixed_text(3, e.geoid_separation_m) + ",M,1.0,0001"));
+  out.push_back(nmea_sentence(
+      "GNRMC," + time + ",A," + lat + "," + lon + "," + fixed_text(3, e.speed_mps * 3600.0 / 1852.0) + "," +
+      (e.course_deg ? fixed_text(2, *e.course_deg) : std::string()) + "," + nmea_date(e.utc_ns) + ",,,D"));
   out.push_back(nmea_sentence("GNHDT," + fixed_text(2, e.heading_deg) + ",T"));
   return out;
 }

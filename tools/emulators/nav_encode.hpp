@@ -25,10 +25,10 @@ namespace fieldguard::tools {
 
 // One epoch of an RTK receiver (fix quality 4, RTK fixed).
 struct GnssEpoch {
-  std::int64_t utc_ns = 0;          // the epoch
+  std::int64_t utc_ns = 0;  // the epoch
   double lat_deg = 0.0;
   double lon_deg = 0.0;
-  double h_m = 0.0;                 // ellipsoidal height; GGA prints h_m - geoid_separation_m
+  double h_m = 0.0;  // ellipsoidal height; GGA prints h_m - geoid_separation_m
   double geoid_separation_m = 0.0;
   int satellites = 0;
   double speed_mps = 0.0;

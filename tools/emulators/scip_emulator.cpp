@@ -13,10 +13,10 @@
 
 #include <chrono>
 #include <cmath>
-#include <numbers>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <numbers>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -57,13 +57,13 @@ std::uint32_t range_mm(int step, const Options& o, std::uint32_t scan_index) {
   const double a = (step - 540) * 0.25 * std::numbers::pi / 180.0;  // + counter-clockwise, 0 = front
   const double c = std::cos(a);
   double r = 60000.0;
-  if (c > 0.05) r = std::min(r, 8000.0 / c);            // the wall 8 m ahead
+  if (c > 0.05) r = std::min(r, 8000.0 / c);  // the wall 8 m ahead
   const double s = std::sin(a);
-  if (o.obstacle && c > 0.0) {                           // box face 1.0 m ahead, |y| <= 0.3 m
+  if (o.obstacle && c > 0.0) {  // box face 1.0 m ahead, |y| <= 0.3 m
     const double t = 1000.0 / c;
     if (std::fabs(t * s) <= 300.0) r = std::min(r, t);
   }
-  if (r >= 60000.0) return 1;                            // no echo: an error code below DMIN
+  if (r >= 60000.0) return 1;                                            // no echo: an error code below DMIN
   return static_cast<std::uint32_t>(std::lround(r)) + (scan_index % 3);  // a little life in the numbers
 }
 
@@ -88,7 +88,9 @@ void serve(int fd, const Options& o) {
   auto next_scan = t0;
   for (;;) {
     pollfd p{fd, POLLIN, 0};
-    const auto wait = sensor.streaming() ? std::chrono::duration_cast<std::chrono::milliseconds>(next_scan - Clock::now()).count() : 1000;
+    const auto wait = sensor.streaming()
+                          ? std::chrono::duration_cast<std::chrono::milliseconds>(next_scan - Clock::now()).count()
+                          : 1000;
     const int r = ::poll(&p, 1, static_cast<int>(std::max<long long>(0, wait)));
     if (r < 0) return;
     if (r > 0) {
@@ -110,7 +112,8 @@ void serve(int fd, const Options& o) {
     }
     if (sensor.streaming() && Clock::now() >= next_scan) {
       next_scan += std::chrono::milliseconds(25);
-      const auto ms = static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count());
+      const auto ms =
+          static_cast<std::uint32_t>(std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count());
       std::vector<std::uint32_t> ranges;
       std::vector<std::uint32_t> intensities;
       for (int step = sensor.first_step(); step <= sensor.last_step(); ++step) {
@@ -160,7 +163,8 @@ int main(int argc, char** argv) {
               "after N scans of a connection, send 300 bytes of garbage once, then go on\n(-1, the default: never)")
       ->type_name("N");
   app.add_flag("--refuse-laser", o.refuse_laser, "answer BM with status 01 (laser could not be lit)");
-  cli::number(app, "--max-clients", o.max_clients, scans, "exit after serving N connections (default: serve until killed)")
+  cli::number(app, "--max-clients", o.max_clients, scans,
+              "exit after serving N connections (default: serve until killed)")
       ->type_name("N");
   if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
   const int srv = ::socket(AF_INET, SOCK_STREAM, 0);

@@ -24,16 +24,18 @@ std::string ScipSensor::reply(std::string_view line_view) {
   if (line.rfind("SCIP2.0", 0) == 0) {
     reply += with_check("00") + "\n";
   } else if (cmd == "VV") {
-    reply += with_check("00") + info_line("VEND:Hokuyo Automatic Co.,Ltd.") + info_line("PROD:SOKUIKI Sensor UTM-30LX-EW") +
-             info_line("FIRM:" + id_.firmware) + info_line("PROT:SCIP 2.0") + info_line("SERI:" + id_.serial) + "\n";
+    reply += with_check("00") + info_line("VEND:Hokuyo Automatic Co.,Ltd.") +
+             info_line("PROD:SOKUIKI Sensor UTM-30LX-EW") + info_line("FIRM:" + id_.firmware) +
+             info_line("PROT:SCIP 2.0") + info_line("SERI:" + id_.serial) + "\n";
   } else if (cmd == "PP") {
     reply += with_check("00") + info_line("MODL:UTM-30LX-EW") + info_line("DMIN:23") + info_line("DMAX:60000") +
              info_line("ARES:1440") + info_line("AMIN:0") + info_line("AMAX:1080") + info_line("AFRT:540") +
              info_line("SCAN:2400") + "\n";
   } else if (cmd == "II") {
     reply += with_check("00") + info_line("MODL:UTM-30LX-EW") + info_line(laser_ ? "LASR:ON" : "LASR:OFF") +
-             info_line("SCSP:2400") + info_line("MESM:Measuring by Sensitive Mode") + info_line("SBPS:Ethernet 100 [Mbps]") +
-             info_line("TIME:000000") + info_line("STAT:Stable 000 no error.") + "\n";
+             info_line("SCSP:2400") + info_line("MESM:Measuring by Sensitive Mode") +
+             info_line("SBPS:Ethernet 100 [Mbps]") + info_line("TIME:000000") + info_line("STAT:Stable 000 no error.") +
+             "\n";
   } else if (cmd == "BM") {
     if (id_.refuse_laser) {
       reply += with_check("01") + "\n";
@@ -76,7 +78,8 @@ std::string ScipSensor::scan(std::span<const std::uint32_t> ranges, std::span<co
     scip::encode_chars(ranges[i], 3, data);
     if (intensity_) scip::encode_chars(i < intensities.size() ? intensities[i] : 0U, 3, data);
   }
-  for (std::size_t i = 0; i < data.size(); i += scip::kDataCharsPerLine) out += with_check(data.substr(i, scip::kDataCharsPerLine));
+  for (std::size_t i = 0; i < data.size(); i += scip::kDataCharsPerLine)
+    out += with_check(data.substr(i, scip::kDataCharsPerLine));
   return out + "\n";
 }
 

@@ -36,8 +36,7 @@ constexpr const char* kAbout =
     "--link) on stdout, one line, then plays. The slave side is raw and held open: bytes written before the\n"
     "reader opens it wait in the pty unchanged.";
 
-constexpr const char* kFooter =
-    "Exit codes: 0 played; 2 bad command line, unreadable file, or the pty failed.";
+constexpr const char* kFooter = "Exit codes: 0 played; 2 bad command line, unreadable file, or the pty failed.";
 
 int fail(const std::string& what) {
   std::fprintf(stderr, "fieldguard-serial-emulator: %s\n", what.c_str());
@@ -78,7 +77,8 @@ int main(int argc, char** argv) {
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 
   const int master = ::posix_openpt(O_RDWR | O_NOCTTY);
-  if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0) return fail(std::string("no pty: ") + std::strerror(errno));
+  if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0)
+    return fail(std::string("no pty: ") + std::strerror(errno));
   const std::string slave_path = ::ptsname(master);
   const int slave = ::open(slave_path.c_str(), O_RDWR | O_NOCTTY);
   if (slave < 0) return fail("cannot open " + slave_path);
@@ -103,8 +103,9 @@ int main(int argc, char** argv) {
     for (std::size_t off = 0; off < bytes.size(); off += chunk) {
       const std::size_t n = std::min<std::size_t>(chunk, bytes.size() - off);
       if (baud > 0) {
-        std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                  std::chrono::duration<double>(static_cast<double>(written) / bytes_per_s)));
+        std::this_thread::sleep_until(start +
+                                      std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                          std::chrono::duration<double>(static_cast<double>(written) / bytes_per_s)));
       }
       std::size_t done = 0;
       while (done < n) {

@@ -61,7 +61,8 @@ constexpr std::int64_t kUsPerHour = 3'600'000'000LL;
 
 void stamp_now(std::vector<std::uint8_t>& payload) {
   const std::int64_t us =
-      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count();
   const auto past_hour = static_cast<std::uint32_t>(((us % kUsPerHour) + kUsPerHour) % kUsPerHour);
   for (std::size_t i = 0; i < 4; ++i) payload[kTimestampOffset + i] = static_cast<std::uint8_t>(past_hour >> (8U * i));
 }
@@ -121,7 +122,8 @@ int main(int argc, char** argv) {
   if (pcap.empty()) return tool.fail("--pcap is required");
   sockaddr_in to{};
   to.sin_family = AF_INET;
-  if (::inet_pton(AF_INET, host.c_str(), &to.sin_addr) != 1) return tool.fail("--host: wants an IPv4 address, not '" + host + "'");
+  if (::inet_pton(AF_INET, host.c_str(), &to.sin_addr) != 1)
+    return tool.fail("--host: wants an IPv4 address, not '" + host + "'");
 
   auto reader = fieldguard::io::PcapReader::open(pcap);
   if (!reader) {
@@ -160,7 +162,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   if (delay_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
 
-  struct sigaction sa{};
+  struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sa.sa_flags = SA_RESTART;
   ::sigaction(SIGTERM, &sa, nullptr);
@@ -179,8 +181,8 @@ int main(int argc, char** argv) {
       if (g_stop != 0) break;
       if (speed > 0.0) {
         const double offset_s = static_cast<double>(d.t_ns - datagrams.front().t_ns + l * period_ns) * 1e-9 / speed;
-        std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
-                                                  std::chrono::duration<double>(offset_s)));
+        std::this_thread::sleep_until(
+            start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(offset_s)));
       }
       if (live_time && d.payload.size() == kDataPacketSize) stamp_now(d.payload);
       to.sin_port = htons(d.port);
@@ -193,9 +195,9 @@ int main(int argc, char** argv) {
       }
       // When the receiver last heard from us, on the clock its logs use: a test of a silence timeout measures
       // from here, not from when it saw this process exit (late by a scheduling delay on a loaded machine).
-      last_sent_us = std::chrono::duration_cast<std::chrono::microseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
+      last_sent_us =
+          std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+              .count();
       ++sent;
       if (d.payload.size() == kDataPacketSize) ++sent_data;
     }

@@ -49,7 +49,8 @@ FrameMatch match_frames(const std::vector<TruthFrame>& truth, const std::vector<
     }
     if (pick < detections.size()) candidates.push_back({best, t, pick});
   }
-  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.gap < b.gap; });
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.gap < b.gap; });
   std::vector<bool> truth_used(truth.size(), false);
   std::vector<bool> det_used(detections.size(), false);
   FrameMatch m;

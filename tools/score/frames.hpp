@@ -39,7 +39,7 @@ struct DetectionFrame {
 
 struct TruthItem {
   std::string id;
-  std::string cls;   // pedestrian implement haystack house tree crown | clod ridge crop body
+  std::string cls;  // pedestrian implement haystack house tree crown | clod ridge crop body
   Box box;
   long hits = 0;
   long raised_hits = -1;    // returns 0.5 m or more above the surface; -1: the line does not say

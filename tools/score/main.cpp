@@ -18,7 +18,8 @@ namespace cli = fieldguard::tools::cli;
 
 constexpr const char* kSynopsis =
     "fieldguard-score --detections FILE --truth FILE [--json] [--margin M] [--min-overlap F]\n"
-    "                        [--min-hits N] [--min-raised-hits N] [--region X0,Y0,X1,Y1 | --region none] [--include-partial]\n"
+    "                        [--min-hits N] [--min-raised-hits N] [--region X0,Y0,X1,Y1 | --region none] "
+    "[--include-partial]\n"
     "                        [--tolerance S]";
 
 constexpr const char* kAbout =
@@ -70,31 +71,37 @@ int main(int argc, char** argv) {
       ->type_name("FILE");
   app.add_option("--truth", truth_path, "ground truth (fieldguard-sim --truth)")->type_name("FILE");
   app.add_flag("--json", json, "print one JSON object instead of the tables (layout: tools/score/report.hpp)");
-  cli::number(app, "--margin", params.margin_m, [](double m) { return m >= 0.0; }, "metres >= 0",
-              "grow truth boxes by M metres on every side before testing overlap (default 0.3)")
+  cli::number(
+      app, "--margin", params.margin_m, [](double m) { return m >= 0.0; }, "metres >= 0",
+      "grow truth boxes by M metres on every side before testing overlap (default 0.3)")
       ->type_name("M");
   cli::number(app, "--min-overlap", params.min_overlap, cli::Between<double>{0.0, 1.0}, "a fraction from 0 to 1",
               "on x and y the overlap must be at least F of the shorter extent (default 0.5)")
       ->type_name("F");
-  cli::number(app, "--min-hits", params.min_hits, [](long n) { return n >= 1; }, "a whole number >= 1",
-              "a real object is visible with at least N returns (default 3)")
+  cli::number(
+      app, "--min-hits", params.min_hits, [](long n) { return n >= 1; }, "a whole number >= 1",
+      "a real object is visible with at least N returns (default 3)")
       ->type_name("N");
-  cli::number(app, "--min-raised-hits", params.min_raised_hits, [](long n) { return n >= 0; }, "a whole number >= 0",
-              "and at least N of them 0.5 m or more above the field surface under them\n"
-              "(default 3; the truth's \"raised_hits\"; 0: any returns count, as before)")
+  cli::number(
+      app, "--min-raised-hits", params.min_raised_hits, [](long n) { return n >= 0; }, "a whole number >= 0",
+      "and at least N of them 0.5 m or more above the field surface under them\n"
+      "(default 3; the truth's \"raised_hits\"; 0: any returns count, as before)")
       ->type_name("N");
-  cli::checked(app, "--region", params.region, parse_region, [](const auto& /*region*/) { return true; },
-               "X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1 (metres), or none",
-               "and only if its box overlaps this x-y rectangle (default -10,-10,50,10: the\n"
-               "configured region of interest); 'none' for everywhere")
+  cli::checked(
+      app, "--region", params.region, parse_region, [](const auto& /*region*/) { return true; },
+      "X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1 (metres), or none",
+      "and only if its box overlaps this x-y rectangle (default -10,-10,50,10: the\n"
+      "configured region of interest); 'none' for everywhere")
       ->type_name("X0,Y0,X1,Y1|none");
   app.add_flag("--include-partial", params.include_partial,
                "also score detection frames marked \"partial\": true (skipped by default)");
-  cli::number(app, "--tolerance", params.tolerance_s, [](double t) { return t > 0.0; }, "seconds > 0",
-              "largest stamp difference of paired frames, seconds")
+  cli::number(
+      app, "--tolerance", params.tolerance_s, [](double t) { return t > 0.0; }, "seconds > 0",
+      "largest stamp difference of paired frames, seconds")
       ->type_name("S");
   if (const auto exit_code = tool.parse(argc, argv)) return *exit_code;
-  if (detections_path.empty() || truth_path.empty()) return tool.fail("--detections FILE and --truth FILE are required");
+  if (detections_path.empty() || truth_path.empty())
+    return tool.fail("--detections FILE and --truth FILE are required");
 
   std::vector<TruthFrame> truth;
   std::vector<DetectionFrame> detections;

@@ -36,8 +36,8 @@ void score_frame(const TruthFrame& t, const DetectionFrame& d, const ScoreParams
   }
   // match[o][i]: obstacle o matches object i.
   std::vector<std::vector<bool>> match(n_obs, std::vector<bool>(n_obj, false));
-  std::vector<std::size_t> obstacles_on(n_obj, 0);  // per object
-  std::vector<std::size_t> visible_under(n_obs, 0); // per obstacle: visible objects it matches
+  std::vector<std::size_t> obstacles_on(n_obj, 0);   // per object
+  std::vector<std::size_t> visible_under(n_obs, 0);  // per obstacle: visible objects it matches
   std::vector<bool> any_match(n_obs, false);
   for (std::size_t o = 0; o < n_obs; ++o) {
     for (std::size_t i = 0; i < n_obj; ++i) {
@@ -89,7 +89,8 @@ void score_frame(const TruthFrame& t, const DetectionFrame& d, const ScoreParams
     false_in_band[band_of(horizontal_distance(d.obstacles[o].box))] = true;
     const TruthItem* cause = nullptr;
     for (const TruthItem& ti : t.terrain) {
-      if (matches(d.obstacles[o].box, ti.box, p.margin_m, p.min_overlap) && (cause == nullptr || ti.hits > cause->hits)) {
+      if (matches(d.obstacles[o].box, ti.box, p.margin_m, p.min_overlap) &&
+          (cause == nullptr || ti.hits > cause->hits)) {
         cause = &ti;
       }
     }

@@ -82,12 +82,12 @@ struct ScoreReport {
   std::size_t matched_frames = 0;
   std::size_t partial_skipped = 0;
   std::size_t scored_frames = 0;
-  std::vector<std::size_t> truth_unmatched_lines;      // 1-based lines in the truth file
-  std::vector<std::size_t> detections_unmatched_lines; // 1-based lines in the detections file
+  std::vector<std::size_t> truth_unmatched_lines;       // 1-based lines in the truth file
+  std::vector<std::size_t> detections_unmatched_lines;  // 1-based lines in the detections file
   std::array<Rate, kBands> pedestrian{};
   std::array<Rate, kBands> ground_false{};
-  std::map<std::string, Rate> classes;                 // by class name
-  std::map<std::string, std::uint64_t> false_causes;   // clod, ridge, crop, body, none
+  std::map<std::string, Rate> classes;                // by class name
+  std::map<std::string, std::uint64_t> false_causes;  // clod, ridge, crop, body, none
   CrownStats crowns;
   std::uint64_t over_segmented = 0;
   std::uint64_t under_segmented = 0;

@@ -53,15 +53,17 @@ std::string format_text(const ScoreReport& r, const std::string& detections_path
   std::string s = "fieldguard-score: " + detections_path + " against " + truth_path + "\n";
   s += "frames: truth " + std::to_string(r.truth_frames) + ", detections " + std::to_string(r.detection_frames) +
        ", matched " + std::to_string(r.matched_frames) + " (stamps within " + fixed(r.tolerance_s, 4) +
-       " s), partial skipped " + std::to_string(r.partial_skipped) + ", scored " + std::to_string(r.scored_frames) + "\n";
-  if (!r.truth_unmatched_lines.empty()) s += "  truth lines with no detection frame: " + list_lines(r.truth_unmatched_lines) + "\n";
+       " s), partial skipped " + std::to_string(r.partial_skipped) + ", scored " + std::to_string(r.scored_frames) +
+       "\n";
+  if (!r.truth_unmatched_lines.empty())
+    s += "  truth lines with no detection frame: " + list_lines(r.truth_unmatched_lines) + "\n";
   if (!r.detections_unmatched_lines.empty()) {
     s += "  detection lines with no truth frame: " + list_lines(r.detections_unmatched_lines) + "\n";
   }
-  s += "match: obstacle box overlaps the truth box grown by " + fixed(r.params.margin_m, 2) + " m (x, y: by >= " +
-       fixed(r.params.min_overlap * 100.0, 0) + "% of the shorter extent); visible: >= " +
-       std::to_string(r.params.min_hits) + " returns, >= " + std::to_string(r.params.min_raised_hits) +
-       " of them 0.5 m above the surface";
+  s += "match: obstacle box overlaps the truth box grown by " + fixed(r.params.margin_m, 2) +
+       " m (x, y: by >= " + fixed(r.params.min_overlap * 100.0, 0) +
+       "% of the shorter extent); visible: >= " + std::to_string(r.params.min_hits) +
+       " returns, >= " + std::to_string(r.params.min_raised_hits) + " of them 0.5 m above the surface";
   if (r.params.region) {
     const auto& g = *r.params.region;
     s += ", box in x " + fixed(g[0], 1) + ".." + fixed(g[2], 1) + " y " + fixed(g[1], 1) + ".." + fixed(g[3], 1) + " m";
@@ -75,7 +77,8 @@ std::string format_text(const ScoreReport& r, const std::string& detections_path
          pad(fraction(g.hits, g.total), 28) + percent(g) + "\n";
   }
   s += "\nclass       detected/visible  rate\n";
-  for (const auto& [name, rate] : r.classes) s += pad(name, 12) + pad(fraction(rate.hits, rate.total), 18) + percent(rate) + "\n";
+  for (const auto& [name, rate] : r.classes)
+    s += pad(name, 12) + pad(fraction(rate.hits, rate.total), 18) + percent(rate) + "\n";
   const CrownStats& c = r.crowns;
   s += "\ncrowns: visible " + std::to_string(c.visible) + ", true positive " + std::to_string(c.tp) + " (" +
        percent({c.tp, c.visible}) + "), missed " + std::to_string(c.missed) + ", split " + std::to_string(c.split) +
@@ -103,10 +106,12 @@ std::string format_json(const ScoreReport& r) {
   }
   s += std::string(", \"include_partial\": ") + (r.params.include_partial ? "true" : "false") +
        ", \"tolerance_s\": " + fixed(r.tolerance_s, 6) + ", \"period_s\": " + fixed(r.period_s, 6) + "}";
-  s += ", \"frames\": {\"truth\": " + std::to_string(r.truth_frames) + ", \"detections\": " +
-       std::to_string(r.detection_frames) + ", \"matched\": " + std::to_string(r.matched_frames) +
-       ", \"partial_skipped\": " + std::to_string(r.partial_skipped) + ", \"scored\": " +
-       std::to_string(r.scored_frames) + ", \"truth_unmatched_lines\": " + json_lines(r.truth_unmatched_lines) +
+  s += ", \"frames\": {\"truth\": " + std::to_string(r.truth_frames) +
+       ", \"detections\": " + std::to_string(r.detection_frames) +
+       ", \"matched\": " + std::to_string(r.matched_frames) +
+       ", \"partial_skipped\": " + std::to_string(r.partial_skipped) +
+       ", \"scored\": " + std::to_string(r.scored_frames) +
+       ", \"truth_unmatched_lines\": " + json_lines(r.truth_unmatched_lines) +
        ", \"detections_unmatched_lines\": " + json_lines(r.detections_unmatched_lines) + "}";
   auto band_head = [](std::size_t b) {
     const std::string hi = b + 1 >= kBands ? std::string("null") : std::to_string(5 * (b + 1));
@@ -138,10 +143,11 @@ std::string format_json(const ScoreReport& r) {
        ", \"frames\": " + std::to_string(c.frames) + ", \"obstacles\": " + std::to_string(c.obstacles) +
        ", \"false_obstacles\": " + std::to_string(c.false_obstacles) +
        ", \"false_rate\": " + json_rate({c.false_obstacles, c.obstacles}) + "}";
-  s += ", \"segmentation\": {\"over\": " + std::to_string(r.over_segmented) + ", \"under\": " +
-       std::to_string(r.under_segmented) + "}";
-  s += ", \"obstacles\": {\"total\": " + std::to_string(r.obstacles) + ", \"false\": " +
-       std::to_string(r.false_obstacles) + ", \"false_by_cause\": {\"clod\": " + std::to_string(cause(r, "clod")) +
+  s += ", \"segmentation\": {\"over\": " + std::to_string(r.over_segmented) +
+       ", \"under\": " + std::to_string(r.under_segmented) + "}";
+  s += ", \"obstacles\": {\"total\": " + std::to_string(r.obstacles) +
+       ", \"false\": " + std::to_string(r.false_obstacles) +
+       ", \"false_by_cause\": {\"clod\": " + std::to_string(cause(r, "clod")) +
        ", \"ridge\": " + std::to_string(cause(r, "ridge")) + ", \"crop\": " + std::to_string(cause(r, "crop")) +
        ", \"body\": " + std::to_string(cause(r, "body")) + ", \"none\": " + std::to_string(cause(r, "none")) + "}}}";
   return s;

@@ -2,7 +2,8 @@
 // The scorer's output: a text table for people and one JSON object for programs (--json).
 //
 // JSON layout (rates are fractions 0..1, null where nothing was counted):
-// {"params": {"margin_m", "min_overlap", "min_hits", "min_raised_hits", "region": [x0, y0, x1, y1] | null, "include_partial", "tolerance_s",
+// {"params": {"margin_m", "min_overlap", "min_hits", "min_raised_hits", "region": [x0, y0, x1, y1] | null,
+// "include_partial", "tolerance_s",
 //             "period_s"},
 //  "frames": {"truth", "detections", "matched", "partial_skipped", "scored",
 //             "truth_unmatched_lines": [...], "detections_unmatched_lines": [...]},

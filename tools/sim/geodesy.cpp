@@ -6,9 +6,9 @@ namespace fieldguard::sim {
 
 namespace {
 
-constexpr double kA = 6378137.0;                // WGS84 semi-major axis, m
-constexpr double kF = 1.0 / 298.257223563;      // flattening
-constexpr double kE2 = kF * (2.0 - kF);         // first eccentricity squared
+constexpr double kA = 6378137.0;            // WGS84 semi-major axis, m
+constexpr double kF = 1.0 / 298.257223563;  // flattening
+constexpr double kE2 = kF * (2.0 - kF);     // first eccentricity squared
 
 Vec3 ecef_of(const Geodetic& g) {
   const double lat = g.lat_deg * kDegToRad;

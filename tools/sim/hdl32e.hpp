@@ -11,9 +11,9 @@ namespace fieldguard::sim::hdl32e {
 inline constexpr std::size_t kLasers = 32;
 inline constexpr std::size_t kBlocksPerPacket = 12;
 inline constexpr std::size_t kPacketSize = 1206;
-inline constexpr std::int64_t kFiringNs = 1152;            // one laser firing, 1.152 us
-inline constexpr std::int64_t kBlockNs = 46080;            // one firing sequence (= one block), 46.08 us
-inline constexpr std::int64_t kPacketNs = 12 * kBlockNs;   // 552.96 us
+inline constexpr std::int64_t kFiringNs = 1152;           // one laser firing, 1.152 us
+inline constexpr std::int64_t kBlockNs = 46080;           // one firing sequence (= one block), 46.08 us
+inline constexpr std::int64_t kPacketNs = 12 * kBlockNs;  // 552.96 us
 // The packet timestamp marks the LAST firing of the packet (HDL-32E manual, appendix E; protocols.md §1.7):
 // 11 * 46.08 + 31 * 1.152 = 542.592 us after block 0 slot 0.
 inline constexpr std::int64_t kLastFiringNs = 11 * kBlockNs + 31 * kFiringNs;

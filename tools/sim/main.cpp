@@ -1,11 +1,11 @@
 // fieldguard-sim: writes an HDL-32E capture (classic pcap) of a simulated scene and its ground truth (JSONL).
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -116,27 +116,29 @@ void declare(CLI::App& app, Options& opt) {
       "LAT,LON,H (|lat| <= 85 deg, |lon| <= 180 deg, |h| <= 9000 m)",
       "the world origin (WGS84 deg, deg, m; default 48.1,11.6,520: north of Munich)")
       ->type_name("LAT,LON,H");
-  cli::number(app, "--heading", opt.heading_deg, [](double d) { return d >= 0.0 && d < 360.0; },
-              "degrees from 0 to under 360 (clockwise from north)",
-              "compass heading of the tractor's path (default 60)")
+  cli::number(
+      app, "--heading", opt.heading_deg, [](double d) { return d >= 0.0 && d < 360.0; },
+      "degrees from 0 to under 360 (clockwise from north)", "compass heading of the tractor's path (default 60)")
       ->type_name("DEG");
   app.add_option("--truth", opt.truth, "ground truth to write (default: FILE without .pcap + .truth.jsonl)")
       ->type_name("FILE");
-  cli::number(app, "--rotations", opt.rotations, [](int n) { return n >= 1; }, "a whole number >= 1",
-              "rotations to simulate (default: the scene's)")
+  cli::number(
+      app, "--rotations", opt.rotations, [](int n) { return n >= 1; }, "a whole number >= 1",
+      "rotations to simulate (default: the scene's)")
       ->type_name("N");
   cli::number(app, "--rate", opt.rate_hz, cli::Between<double>{5.0, 20.0},
               "a number of Hz from 5 to 20 (the HDL-32E's range)",
               "rotation rate, 5..20 (default 10); rounded to a whole number of packets per\n"
               "rotation: 10 -> 181 packets (9.991 Hz), 5 -> 362 packets (4.996 Hz)")
       ->type_name("HZ");
-  cli::number(app, "--seed", opt.seed, [](std::uint64_t /*seed*/) { return true; }, "a whole number >= 0",
-              "random seed (default 1); the same seed gives byte-identical output")
+  cli::number(
+      app, "--seed", opt.seed, [](std::uint64_t /*seed*/) { return true; }, "a whole number >= 0",
+      "random seed (default 1); the same seed gives byte-identical output")
       ->type_name("N");
-  cli::number(app, "--start-time", opt.start_s, [](std::int64_t t) { return t >= 0; },
-              "Unix seconds (a whole number >= 0)",
-              "Unix time of the first firing (default 1718449170 = 10:59:30 UTC, so the\n"
-              "packet timestamps wrap at the top of the hour after 30 s)")
+  cli::number(
+      app, "--start-time", opt.start_s, [](std::int64_t t) { return t >= 0; }, "Unix seconds (a whole number >= 0)",
+      "Unix time of the first firing (default 1718449170 = 10:59:30 UTC, so the\n"
+      "packet timestamps wrap at the top of the hour after 30 s)")
       ->type_name("S");
   cli::number(app, "--threads", opt.threads, cli::Between<unsigned>{0, 64},
               "threads casting rays (default 1; 0 = one per hardware thread, at most 8);\n"
@@ -215,7 +217,8 @@ int main(int argc, char** argv) {
     truth << truth_json_line(t) << '\n';
     points += t.returns;
     packet_count += packets.size();
-    if (!opt.quiet && (k + 1) % 100 == 0) std::cerr << "fieldguard-sim: " << (k + 1) << "/" << rotations << " rotations\n";
+    if (!opt.quiet && (k + 1) % 100 == 0)
+      std::cerr << "fieldguard-sim: " << (k + 1) << "/" << rotations << " rotations\n";
   }
   truth.close();
   if (!truth || !pcap.close()) {

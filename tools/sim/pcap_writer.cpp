@@ -27,8 +27,8 @@ void be16(std::uint8_t* p, std::uint16_t v) {
 void build_udp_headers(std::uint8_t* h, std::size_t payload_size, std::uint16_t ip_id, std::uint16_t src_port,
                        std::uint16_t dst_port) {
   // Ethernet II: broadcast destination, a Velodyne OUI (60:76:88) source, EtherType IPv4.
-  constexpr std::array<std::uint8_t, 14> eth{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x60, 0x76,
-                                             0x88, 0x00, 0x00, 0x01, 0x08, 0x00};
+  constexpr std::array<std::uint8_t, 14> eth{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0x60,
+                                             0x76, 0x88, 0x00, 0x00, 0x01, 0x08, 0x00};
   std::memcpy(h, eth.data(), eth.size());
   std::uint8_t* ip = h + 14;
   const auto udp_len = static_cast<std::uint16_t>(8 + payload_size);

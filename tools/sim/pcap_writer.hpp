@@ -20,8 +20,8 @@ class PcapWriter {
   // Creates the file and writes the global header. False (with error()) if it cannot.
   [[nodiscard]] bool open(const std::string& path);
   // One record, time in ns since the Unix epoch (written truncated to microseconds).
-  [[nodiscard]] bool write_udp(std::span<const std::uint8_t> payload, std::int64_t time_ns,
-                               std::uint16_t src_port, std::uint16_t dst_port);
+  [[nodiscard]] bool write_udp(std::span<const std::uint8_t> payload, std::int64_t time_ns, std::uint16_t src_port,
+                               std::uint16_t dst_port);
   // Flushes and closes; false if a write failed.
   [[nodiscard]] bool close();
   [[nodiscard]] const std::string& error() const { return error_; }

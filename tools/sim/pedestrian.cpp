@@ -20,8 +20,8 @@ std::vector<Primitive> person_parts(Vec3 feet, double heading, double phase) {
   torso.reflectivity = 45.0;
   parts.push_back(torso);
   for (const double s : {-1.0, 1.0}) {
-    Primitive arm =
-        make_vertical_cylinder(feet + side * (0.235 * s) + fwd * (-0.15 * swing * s) + Vec3{0.0, 0.0, 0.80}, 0.045, 0.64);
+    Primitive arm = make_vertical_cylinder(feet + side * (0.235 * s) + fwd * (-0.15 * swing * s) + Vec3{0.0, 0.0, 0.80},
+                                           0.045, 0.64);
     arm.reflectivity = 45.0;
     parts.push_back(arm);
   }

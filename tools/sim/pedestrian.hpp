@@ -15,7 +15,7 @@
 namespace fieldguard::sim {
 
 struct Crossing {
-  double x_m = 10.0;      // world x of the body's centre line while crossing
+  double x_m = 10.0;  // world x of the body's centre line while crossing
   double y_from_m = -8.0;
   double y_to_m = 8.0;
   double t_begin_s = 0.0;  // at y_from

@@ -61,8 +61,7 @@ bool box_span(const Primitive& p, const LocalRay& r, double tmax, Span& span) {
 }
 
 // Capped cylinder of radius `radius` and half length `half` about local z, centred at local z = `zc`.
-bool cylinder_span(const LocalRay& r, double radius, double half, double zc, double& t_in, double& t_out,
-                   Vec3& n) {
+bool cylinder_span(const LocalRay& r, double radius, double half, double zc, double& t_in, double& t_out, Vec3& n) {
   const double oz = r.o.z - zc;
   double ts0 = -kInf;
   double ts1 = kInf;

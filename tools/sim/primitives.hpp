@@ -19,11 +19,11 @@ enum class Shape : std::uint8_t {
 
 struct Primitive {
   Shape shape = Shape::Box;
-  Vec3 center;            // world position of the local origin
-  Mat3 rot;               // local -> world
-  Vec3 half_size;         // see Shape
-  double reflectivity = 40.0;      // nominal intensity at normal incidence, 0..255
-  double mean_free_path_m = 0.0;   // 0 = solid; > 0 = porous with this mean penetration depth
+  Vec3 center;                    // world position of the local origin
+  Mat3 rot;                       // local -> world
+  Vec3 half_size;                 // see Shape
+  double reflectivity = 40.0;     // nominal intensity at normal incidence, 0..255
+  double mean_free_path_m = 0.0;  // 0 = solid; > 0 = porous with this mean penetration depth
 };
 
 // Where a ray enters and leaves a (convex) primitive, with the outward surface normal at entry (world).

@@ -55,9 +55,9 @@ Aabb visible_bounds(const std::vector<Primitive>& parts, double ground_z) {
 std::vector<Primitive> tractor_body() {
   std::vector<Primitive> body;
   auto box = [&](Vec3 lo, Vec3 hi, double refl) { body.push_back(with_reflectivity(make_box_minmax(lo, hi), refl)); };
-  box({-0.75, -0.45, -0.70}, {0.30, 0.45, -0.30}, 30.0);   // front weights and the sensor bracket below it
-  box({-2.90, -0.50, -0.50}, {-0.60, 0.50, 0.45}, 70.0);   // hood
-  box({-4.60, -0.95, -0.20}, {-2.90, 0.95, 1.50}, 60.0);   // cab
+  box({-0.75, -0.45, -0.70}, {0.30, 0.45, -0.30}, 30.0);  // front weights and the sensor bracket below it
+  box({-2.90, -0.50, -0.50}, {-0.60, 0.50, 0.45}, 70.0);  // hood
+  box({-4.60, -0.95, -0.20}, {-2.90, 0.95, 1.50}, 60.0);  // cab
   for (const double s : {-1.0, 1.0}) {
     body.push_back(with_reflectivity(make_lying_cylinder({-1.5, 0.92 * s, -0.45}, 0.50, 0.20, kPi / 2.0), 8.0));
     body.push_back(with_reflectivity(make_lying_cylinder({-4.1, 1.25 * s, -0.10}, 0.85, 0.25, kPi / 2.0), 8.0));
@@ -71,10 +71,10 @@ SceneObject make_implement(const std::string& id, double x, double y, double yaw
   const Vec3 o{x, y, lowest_ground(t, x, y, 1.5, 1.25, yaw)};
   std::vector<Primitive> parts;
   auto add = [&](Primitive p, double refl) { parts.push_back(place(with_reflectivity(p, refl), o, yaw)); };
-  add(make_box({0.2, 0.0, 0.65}, {1.1, 1.25, 0.10}), 90.0);    // frame, 0.55..0.75 m
-  add(make_box({-0.2, 0.0, 1.125}, {0.6, 1.2, 0.375}), 110.0); // hopper, up to 1.5 m
-  add(make_box({1.7, 0.0, 0.55}, {0.4, 0.08, 0.06}), 90.0);    // drawbar
-  add(make_box({2.0, 0.0, 0.25}, {0.05, 0.05, 0.25}), 90.0);   // parking stand
+  add(make_box({0.2, 0.0, 0.65}, {1.1, 1.25, 0.10}), 90.0);     // frame, 0.55..0.75 m
+  add(make_box({-0.2, 0.0, 1.125}, {0.6, 1.2, 0.375}), 110.0);  // hopper, up to 1.5 m
+  add(make_box({1.7, 0.0, 0.55}, {0.4, 0.08, 0.06}), 90.0);     // drawbar
+  add(make_box({2.0, 0.0, 0.25}, {0.05, 0.05, 0.25}), 90.0);    // parking stand
   for (const double s : {-1.0, 1.0}) add(make_lying_cylinder({-0.6, 1.0 * s, 0.35}, 0.35, 0.12, kPi / 2.0), 8.0);
   for (int k = 0; k < 6; ++k) add(make_box({0.9, -1.0 + 0.4 * k, 0.33}, {0.03, 0.02, 0.22}), 60.0);  // tines
   return finish(id, ObjectClass::Implement, std::move(parts));
@@ -106,7 +106,9 @@ SceneObject make_standing_person(const std::string& id, double x, double y, doub
 SceneObject make_house(const std::string& id, double x, double y, double yaw, const Terrain& t) {
   const Vec3 o{x, y, lowest_ground(t, x, y, 4.0, 3.0, yaw)};
   std::vector<Primitive> parts;
-  auto add = [&](Vec3 c, Vec3 h, double refl) { parts.push_back(place(with_reflectivity(make_box(c, h), refl), o, yaw)); };
+  auto add = [&](Vec3 c, Vec3 h, double refl) {
+    parts.push_back(place(with_reflectivity(make_box(c, h), refl), o, yaw));
+  };
   add({0.0, 0.0, 1.2}, {4.0, 3.0, 1.2}, 120.0);  // plastered walls
   add({0.0, 0.0, 2.5}, {4.2, 3.2, 0.1}, 40.0);   // roof, stepped towards the ridge
   add({0.0, 0.0, 2.7}, {4.2, 2.0, 0.1}, 40.0);
@@ -134,7 +136,8 @@ SceneObject make_orchard_tree(const std::string& id, double x, double y, Vec3 se
   const double trunk_r = rng.uniform(0.06, 0.10);
   const double cz = g + crown_base_m + semi_axes.z;
   std::vector<Primitive> parts;
-  parts.push_back(with_reflectivity(make_vertical_cylinder({x, y, g - 0.1}, trunk_r, crown_base_m + 0.5 * semi_axes.z + 0.1), 35.0));
+  parts.push_back(with_reflectivity(
+      make_vertical_cylinder({x, y, g - 0.1}, trunk_r, crown_base_m + 0.5 * semi_axes.z + 0.1), 35.0));
   parts.push_back(with_reflectivity(make_ellipsoid({x, y, cz}, semi_axes), 55.0, 0.45));
   return finish(id, ObjectClass::Crown, std::move(parts));
 }

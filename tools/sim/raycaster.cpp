@@ -110,7 +110,8 @@ CastHit RayCaster::cast(const SensorPose& pose, Vec3 dir_sensor, const CastHit& 
     // Nothing in this bin from here on can be nearer than what the ray already hit.
     if (cand.near_m > best * dxy) break;
     const std::uint32_t i = cand.index;
-    const SceneObject& o = moving != nullptr && scene_.pedestrian && i == scene_.pedestrian_index ? *moving : scene_.objects[i];
+    const SceneObject& o =
+        moving != nullptr && scene_.pedestrian && i == scene_.pedestrian_index ? *moving : scene_.objects[i];
     double entry = 0.0;
     if (!ray_hits_aabb(ray, inv, o.bounds, best, entry)) continue;
     for (const Primitive& p : o.parts) {

@@ -2,8 +2,8 @@
 // Casts one LiDAR ray into a scene: the tractor's body (sensor frame), the terrain, crop blocks and the
 // objects (world frame); returns the nearest surface and what it belongs to. Objects are found through
 // 0.5-degree bins of world azimuth around the sensor, rebuilt once per rotation and sorted by distance, so
-// a ray tests only the few objects in its direction nearer than what it has already hit. Thread-compatible: cast() may run on several threads at once (each with its
-// own Rng), prepare() alone.
+// a ray tests only the few objects in its direction nearer than what it has already hit. Thread-compatible: cast() may
+// run on several threads at once (each with its own Rng), prepare() alone.
 
 #include <cstdint>
 #include <span>

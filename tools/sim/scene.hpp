@@ -20,9 +20,18 @@
 namespace fieldguard::sim {
 
 enum class ObjectClass : std::uint8_t {
-  Pedestrian, Implement, Haystack, House, Tree, Crown,  // real objects: a detector must report them
-  Pole, Box,
-  Clod, Ridge, Crop, Body,                              // terrain and the tractor: it must not
+  Pedestrian,
+  Implement,
+  Haystack,
+  House,
+  Tree,
+  Crown,  // real objects: a detector must report them
+  Pole,
+  Box,
+  Clod,
+  Ridge,
+  Crop,
+  Body,  // terrain and the tractor: it must not
 };
 [[nodiscard]] std::string_view to_string(ObjectClass c);
 [[nodiscard]] bool is_terrain(ObjectClass c);
@@ -35,17 +44,17 @@ struct SceneObject {
 };
 
 struct MotionParams {
-  double start_x_m = 0.0;        // where the sensor starts (world x)
-  double speed_mps = 0.0;        // along world x
-  double sensor_height_m = 0.95; // above the smooth ground below the sensor
-  bool follow_terrain = true;    // add the attitude of the ground under the tractor (over a 3 m wheelbase)
-  double roll_deg = 0.0;         // constant part
+  double start_x_m = 0.0;         // where the sensor starts (world x)
+  double speed_mps = 0.0;         // along world x
+  double sensor_height_m = 0.95;  // above the smooth ground below the sensor
+  bool follow_terrain = true;     // add the attitude of the ground under the tractor (over a 3 m wheelbase)
+  double roll_deg = 0.0;          // constant part
   double pitch_deg = 0.0;
-  double roll_amp_deg = 0.0;     // slow rocking: amplitude and period
+  double roll_amp_deg = 0.0;  // slow rocking: amplitude and period
   double roll_period_s = 5.0;
   double pitch_amp_deg = 0.0;
   double pitch_period_s = 4.0;
-  double vibration_deg = 0.0;    // engine/ride vibration, a few Hz, on both axes
+  double vibration_deg = 0.0;  // engine/ride vibration, a few Hz, on both axes
   // Braking: the tractor slows at decel_mps2 to stand with its sensor at world x = stop_x_m (inf = never).
   double stop_x_m = kInf;
   double decel_mps2 = 0.5;
@@ -70,10 +79,10 @@ struct Scene {
   std::string name;
   Terrain terrain;
   std::vector<CropBlock> crops;
-  std::vector<SceneObject> objects;       // objects and terrain features (clods, ridge segments)
-  std::optional<Pedestrian> pedestrian;   // animated into objects[pedestrian_index]
+  std::vector<SceneObject> objects;      // objects and terrain features (clods, ridge segments)
+  std::optional<Pedestrian> pedestrian;  // animated into objects[pedestrian_index]
   std::size_t pedestrian_index = 0;
-  std::vector<Primitive> body;            // the tractor, in the SENSOR frame
+  std::vector<Primitive> body;  // the tractor, in the SENSOR frame
   MotionParams motion;
   SensorNoise noise;
 

@@ -142,7 +142,8 @@ Scene uneven_drive(const SceneSetup& setup) {
   auto standing_box = [&](const std::string& id, ObjectClass cls, double x, double y, Vec3 size, double refl) {
     // Sunk 5 cm into the furrowed ground, so that no ray passes under it.
     const double g = s.terrain.base(x, y);
-    Primitive p = make_box_minmax({x - 0.5 * size.x, y - 0.5 * size.y, g - 0.05}, {x + 0.5 * size.x, y + 0.5 * size.y, g + size.z});
+    Primitive p = make_box_minmax({x - 0.5 * size.x, y - 0.5 * size.y, g - 0.05},
+                                  {x + 0.5 * size.x, y + 0.5 * size.y, g + size.z});
     p.reflectivity = refl;
     SceneObject o;
     o.id = id;

@@ -27,7 +27,7 @@ constexpr double kSerialBytesPerS = 115200.0 / 10.0;  // 8N1 at 115200 baud
 constexpr double kAhrsDriftPpm = 20.0;
 constexpr std::uint64_t kAhrsFineAtZero = 3'600'000'000ULL;  // 100 h after power-on: wraps after ~7 min
 constexpr double kScanDriftPpm = -35.0;
-constexpr std::uint64_t kScanMsAtZero = 16'700'000;          // wraps (24 bits) after ~77 s
+constexpr std::uint64_t kScanMsAtZero = 16'700'000;  // wraps (24 bits) after ~77 s
 
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
@@ -92,7 +92,8 @@ class Log {
 std::string target_name(const Scene& scene, std::int64_t target) {
   if (target == RayCaster::kNone) return "none";
   if (target == RayCaster::kTerrain) return "terrain";
-  if (target >= 0 && static_cast<std::size_t>(target) < scene.objects.size()) return scene.objects[static_cast<std::size_t>(target)].id;
+  if (target >= 0 && static_cast<std::size_t>(target) < scene.objects.size())
+    return scene.objects[static_cast<std::size_t>(target)].id;
   if (target >= 0 && static_cast<std::size_t>(target) < scene.objects.size() + scene.crops.size()) return "crop";
   return "body";
 }
@@ -162,12 +163,13 @@ bool write_gnss(Context& c) {
     double host_s = t + 0.020 + 0.020 * rng.uniform();
     for (const std::string& line : sentences) {
       host_s += static_cast<double>(line.size()) / kSerialBytesPerS;
-      if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, line.data(), line.size(), c.error)) return false;
+      if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, line.data(), line.size(), c.error))
+        return false;
     }
-    c.truth << "{\"sensor\": \"gnss\", \"stamp\": " << stamp_text(utc_ns) << ", \"antenna\": {\"lat_deg\": "
-            << fmt(10, truth.lat_deg) << ", \"lon_deg\": " << fmt(10, truth.lon_deg) << ", \"h_m\": "
-            << fmt(4, truth.h_m) << "}, \"antenna_world\": " << vec_text(antenna) << ", \"heading_deg\": "
-            << fmt(3, heading_true) << ", \"speed_mps\": " << fmt(3, speed) << "}\n";
+    c.truth << "{\"sensor\": \"gnss\", \"stamp\": " << stamp_text(utc_ns)
+            << ", \"antenna\": {\"lat_deg\": " << fmt(10, truth.lat_deg) << ", \"lon_deg\": " << fmt(10, truth.lon_deg)
+            << ", \"h_m\": " << fmt(4, truth.h_m) << "}, \"antenna_world\": " << vec_text(antenna)
+            << ", \"heading_deg\": " << fmt(3, heading_true) << ", \"speed_mps\": " << fmt(3, speed) << "}\n";
     ++c.counts.gnss_epochs;
   }
   return log.close(c.error);
@@ -185,7 +187,8 @@ bool write_ahrs(Context& c) {
     const double yaw = wrap_deg(c.place.enu_yaw_deg());
     const auto counter = static_cast<std::uint16_t>(k & 0xFFFFU);
     const auto fine = static_cast<std::uint32_t>(
-        (kAhrsFineAtZero + static_cast<std::uint64_t>(std::llround(t * (1.0 + kAhrsDriftPpm * 1e-6) * 10000.0))) & 0xFFFFFFFFULL);
+        (kAhrsFineAtZero + static_cast<std::uint64_t>(std::llround(t * (1.0 + kAhrsDriftPpm * 1e-6) * 10000.0))) &
+        0xFFFFFFFFULL);
     tools::AhrsSample sample;
     sample.packet_counter = counter;
     sample.sample_time_fine = fine;
@@ -194,12 +197,13 @@ bool write_ahrs(Context& c) {
     sample.yaw_deg = wrap_deg(yaw + 0.1 * rng.normal());
     const std::vector<std::uint8_t> frame = tools::mtdata2_frame(sample);
     const double host_s = t + static_cast<double>(frame.size()) / kSerialBytesPerS + 0.001 + 0.001 * rng.uniform();
-    if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, frame.data(), frame.size(), c.error)) return false;
+    if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, frame.data(), frame.size(), c.error))
+      return false;
     const VehiclePose v = vehicle_pose(c.scene, pose);
-    c.truth << "{\"sensor\": \"ahrs\", \"stamp\": " << stamp_text(c.s.start_time_ns + to_ns(t)) << ", \"packet_counter\": " << counter
-            << ", \"sample_time_fine\": " << fine << ", \"roll_deg\": " << fmt(4, pose.roll_deg) << ", \"pitch_deg\": "
-            << fmt(4, pose.pitch_deg) << ", \"yaw_deg\": " << fmt(4, yaw) << ", \"vehicle_world\": " << vec_text(v.origin)
-            << "}\n";
+    c.truth << "{\"sensor\": \"ahrs\", \"stamp\": " << stamp_text(c.s.start_time_ns + to_ns(t))
+            << ", \"packet_counter\": " << counter << ", \"sample_time_fine\": " << fine
+            << ", \"roll_deg\": " << fmt(4, pose.roll_deg) << ", \"pitch_deg\": " << fmt(4, pose.pitch_deg)
+            << ", \"yaw_deg\": " << fmt(4, yaw) << ", \"vehicle_world\": " << vec_text(v.origin) << "}\n";
     ++c.counts.ahrs_samples;
   }
   return log.close(c.error);
@@ -213,7 +217,8 @@ bool write_scan2d(Context& c) {
   const MotionParams& m = scene.motion;
   // The scanner in the LiDAR's sensor frame (the body is there) and its rays in that frame.
   const Vec3 origin_s = c.s.scan2d.position - Vec3{m.lidar_forward_m, 0.0, m.sensor_height_m};
-  const Mat3 mount = attitude(c.s.scan2d.roll_deg * kDegToRad, c.s.scan2d.pitch_deg * kDegToRad, c.s.scan2d.yaw_deg * kDegToRad);
+  const Mat3 mount =
+      attitude(c.s.scan2d.roll_deg * kDegToRad, c.s.scan2d.pitch_deg * kDegToRad, c.s.scan2d.yaw_deg * kDegToRad);
   std::vector<Vec3> dirs(utm30::kSteps);
   std::vector<CastHit> body(utm30::kSteps);
   for (int i = 0; i < utm30::kSteps; ++i) {
@@ -238,13 +243,16 @@ bool write_scan2d(Context& c) {
   double host_s = -0.5;
   std::string send = client.connect();
   while (!send.empty()) {
-    if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::ToSensor, send.data(), send.size(), c.error)) return false;
+    if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::ToSensor, send.data(), send.size(), c.error))
+      return false;
     std::string line = send;
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
     const std::string reply = sensor.reply(line);
     host_s += 0.002 + 0.001 * rng.uniform();
-    if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, reply.data(), reply.size(), c.error)) return false;
-    const scip::SessionEvents ev = client.on_bytes(ByteSpan(reinterpret_cast<const std::uint8_t*>(reply.data()), reply.size()));
+    if (!log.write(c.s.start_time_ns + to_ns(host_s), io::Direction::FromSensor, reply.data(), reply.size(), c.error))
+      return false;
+    const scip::SessionEvents ev =
+        client.on_bytes(ByteSpan(reinterpret_cast<const std::uint8_t*>(reply.data()), reply.size()));
     if (!ev.refusals.empty()) {
       c.error = "the simulated scanner refused the client's start-up";
       return false;
@@ -302,16 +310,19 @@ bool write_scan2d(Context& c) {
       }
     }
     const auto ms = static_cast<std::uint32_t>(
-        (kScanMsAtZero + static_cast<std::uint64_t>(std::floor(t0 * (1.0 + kScanDriftPpm * 1e-6) * 1000.0))) & 0xFFFFFFU);
+        (kScanMsAtZero + static_cast<std::uint64_t>(std::floor(t0 * (1.0 + kScanDriftPpm * 1e-6) * 1000.0))) &
+        0xFFFFFFU);
     const std::string reply = sensor.scan(ranges, {}, ms);
     // Sent when the last step is measured (18.75 ms into the 25 ms turn); 1-3 ms through the network stack.
     const double host = t0 + utm30::kSteps * step_s + 0.001 + 0.002 * rng.uniform();
-    if (!log.write(c.s.start_time_ns + to_ns(host), io::Direction::FromSensor, reply.data(), reply.size(), c.error)) return false;
+    if (!log.write(c.s.start_time_ns + to_ns(host), io::Direction::FromSensor, reply.data(), reply.size(), c.error))
+      return false;
     const SensorPose p0 = scene.pose_at(t0);
-    c.truth << "{\"sensor\": \"scan2d\", \"stamp\": " << stamp_text(c.s.start_time_ns + to_ns(t0)) << ", \"timestamp_ms\": " << ms
-            << ", \"scanner_world\": " << vec_text(p0.position + p0.rot * origin_s) << ", \"roll_deg\": " << fmt(4, p0.roll_deg)
-            << ", \"pitch_deg\": " << fmt(4, p0.pitch_deg) << ", \"front_range_m\": " << fmt(4, front_range)
-            << ", \"front_target\": \"" << target_name(scene, front_target) << "\"}\n";
+    c.truth << "{\"sensor\": \"scan2d\", \"stamp\": " << stamp_text(c.s.start_time_ns + to_ns(t0))
+            << ", \"timestamp_ms\": " << ms << ", \"scanner_world\": " << vec_text(p0.position + p0.rot * origin_s)
+            << ", \"roll_deg\": " << fmt(4, p0.roll_deg) << ", \"pitch_deg\": " << fmt(4, p0.pitch_deg)
+            << ", \"front_range_m\": " << fmt(4, front_range) << ", \"front_target\": \""
+            << target_name(scene, front_target) << "\"}\n";
     ++c.counts.scans;
   }
   return log.close(c.error);
@@ -343,19 +354,22 @@ bool write_session(const Scene& scene, const SessionSettings& s, SessionCounts& 
   truth << "{\"session\": {\"start\": " << stamp_text(s.start_time_ns) << ", \"duration_s\": " << fmt(6, s.duration_s)
         << ", \"origin\": {\"lat_deg\": " << fmt(8, s.origin.lat_deg) << ", \"lon_deg\": " << fmt(8, s.origin.lon_deg)
         << ", \"h_m\": " << fmt(3, s.origin.h_m) << "}, \"field_heading_deg\": " << fmt(3, s.field_heading_deg)
-        << ", \"ahrs_yaw_deg\": " << fmt(3, wrap_deg(c.place.enu_yaw_deg())) << ", \"geoid_separation_m\": "
-        << fmt(3, s.geoid_separation_m) << ", \"antenna_vehicle\": " << vec_text(s.antenna) << ", \"lidar_vehicle\": "
-        << vec_text({scene.motion.lidar_forward_m, 0.0, scene.motion.sensor_height_m}) << ", \"scan2d_vehicle\": "
-        << vec_text(s.scan2d.position) << ", \"scan2d_rpy_deg\": " << vec_text({s.scan2d.roll_deg, s.scan2d.pitch_deg, s.scan2d.yaw_deg})
+        << ", \"ahrs_yaw_deg\": " << fmt(3, wrap_deg(c.place.enu_yaw_deg()))
+        << ", \"geoid_separation_m\": " << fmt(3, s.geoid_separation_m)
+        << ", \"antenna_vehicle\": " << vec_text(s.antenna)
+        << ", \"lidar_vehicle\": " << vec_text({scene.motion.lidar_forward_m, 0.0, scene.motion.sensor_height_m})
+        << ", \"scan2d_vehicle\": " << vec_text(s.scan2d.position)
+        << ", \"scan2d_rpy_deg\": " << vec_text({s.scan2d.roll_deg, s.scan2d.pitch_deg, s.scan2d.yaw_deg})
         << ", \"objects\": [";
   bool first = true;
   for (const SceneObject& o : scene.objects) {
     if (is_terrain(o.cls) || (scene.pedestrian && &o == &scene.objects[scene.pedestrian_index])) continue;
     const Vec3 centre = o.bounds.center();
     const Geodetic g = c.place.to_geodetic({centre.x, centre.y, o.bounds.min.z});
-    truth << (first ? "" : ", ") << "{\"id\": \"" << o.id << "\", \"class\": \"" << to_string(o.cls) << "\", \"world_min\": "
-          << vec_text(o.bounds.min) << ", \"world_max\": " << vec_text(o.bounds.max) << ", \"base_lat_deg\": "
-          << fmt(10, g.lat_deg) << ", \"base_lon_deg\": " << fmt(10, g.lon_deg) << ", \"base_h_m\": " << fmt(4, g.h_m) << "}";
+    truth << (first ? "" : ", ") << "{\"id\": \"" << o.id << "\", \"class\": \"" << to_string(o.cls)
+          << "\", \"world_min\": " << vec_text(o.bounds.min) << ", \"world_max\": " << vec_text(o.bounds.max)
+          << ", \"base_lat_deg\": " << fmt(10, g.lat_deg) << ", \"base_lon_deg\": " << fmt(10, g.lon_deg)
+          << ", \"base_h_m\": " << fmt(4, g.h_m) << "}";
     first = false;
   }
   truth << "]}}\n";

@@ -30,18 +30,18 @@ struct VehicleMount {
 struct SessionSettings {
   std::string dir;
   std::uint64_t seed = 1;
-  std::int64_t start_time_ns = 0;  // UTC of simulation time 0
-  double duration_s = 10.0;        // samples in [0, duration_s)
+  std::int64_t start_time_ns = 0;      // UTC of simulation time 0
+  double duration_s = 10.0;            // samples in [0, duration_s)
   Geodetic origin{48.1, 11.6, 520.0};  // the world origin: a field north of Munich
   double field_heading_deg = 60.0;     // compass heading of world +x (the tractor's path)
   double geoid_separation_m = 47.0;    // ellipsoid - geoid there (GGA reports the height above the geoid)
   Vec3 antenna{0.0, 0.0, 2.8};         // GNSS antenna in the vehicle frame: on the cab roof
   VehicleMount scan2d{{3.95, 0.0, 0.30}, 0.0, 0.0, 0.0};  // the UTM-30LX-EW on the front bumper
   double gnss_rate_hz = 10.0;
-  double gnss_sigma_m = 0.01;          // RTK fixed: horizontal, per axis (1.4 cm radial); vertical twice it
-  double heading_sigma_deg = 0.1;      // dual-antenna heading
+  double gnss_sigma_m = 0.01;      // RTK fixed: horizontal, per axis (1.4 cm radial); vertical twice it
+  double heading_sigma_deg = 0.1;  // dual-antenna heading
   double ahrs_rate_hz = 100.0;
-  double ahrs_sigma_deg = 0.07;        // roll and pitch; yaw 0.1 deg
+  double ahrs_sigma_deg = 0.07;  // roll and pitch; yaw 0.1 deg
   double scan2d_sigma_m = 0.01;
 };
 

@@ -30,7 +30,8 @@ Simulator::Simulator(Scene scene, const SimSettings& settings)
   const double firing_fraction = static_cast<double>(hdl32e::kFiringNs) / static_cast<double>(hdl32e::kBlockNs);
   for (std::size_t b = 0; b < blocks; ++b) {
     for (std::size_t j = 0; j < hdl32e::kLasers; ++j) {
-      const double turn = (static_cast<double>(b) + static_cast<double>(j) * firing_fraction) / static_cast<double>(blocks);
+      const double turn =
+          (static_cast<double>(b) + static_cast<double>(j) * firing_fraction) / static_cast<double>(blocks);
       const double az = 2.0 * kPi * turn;  // clockwise from x
       const double el = hdl32e::kVerticalDeg[j] * kDegToRad;
       directions_[b * hdl32e::kLasers + j] = {std::cos(el) * std::cos(az), -std::cos(el) * std::sin(az), std::sin(el)};
@@ -44,9 +45,7 @@ double Simulator::period_for(double rate_hz) {
   return static_cast<double>(packets_per_rotation_for(rate_hz) * hdl32e::kPacketNs) * 1e-9;
 }
 
-double Simulator::period_s() const {
-  return static_cast<double>(packets_per_rotation_ * hdl32e::kPacketNs) * 1e-9;
-}
+double Simulator::period_s() const { return static_cast<double>(packets_per_rotation_ * hdl32e::kPacketNs) * 1e-9; }
 
 void Simulator::prepare_bins(std::int64_t t0_ns, std::int64_t t1_ns) {
   swept_.resize(scene_.objects.size());
@@ -94,9 +93,9 @@ ObjectTruth Simulator::truth_of(const Aabb& world_box, std::int64_t t0_ns, const
   return t;
 }
 
-void Simulator::simulate_packet(std::uint64_t packet, std::uint64_t in_rotation, TimedPacket& out,
-                                Tally& tally) const {
-  const std::uint64_t blocks_per_rotation = static_cast<std::uint64_t>(packets_per_rotation_) * hdl32e::kBlocksPerPacket;
+void Simulator::simulate_packet(std::uint64_t packet, std::uint64_t in_rotation, TimedPacket& out, Tally& tally) const {
+  const std::uint64_t blocks_per_rotation =
+      static_cast<std::uint64_t>(packets_per_rotation_) * hdl32e::kBlocksPerPacket;
   const std::int64_t tp_ns = static_cast<std::int64_t>(packet) * hdl32e::kPacketNs;
   const double t_mid = static_cast<double>(tp_ns + hdl32e::kPacketNs / 2) * 1e-9;
   const SceneObject* moving = nullptr;

@@ -42,20 +42,20 @@ struct TimedPacket {
 struct ObjectTruth {
   std::string id;
   ObjectClass cls = ObjectClass::Implement;
-  Aabb box;                  // sensor frame, when the sensor's beam swept the object's centre; for an object
-                             // across azimuth 0, the union of where it was at the rotation's start and end
-  std::uint32_t hits = 0;    // returns on it in this rotation (after dropouts)
+  Aabb box;                       // sensor frame, when the sensor's beam swept the object's centre; for an object
+                                  // across azimuth 0, the union of where it was at the rotation's start and end
+  std::uint32_t hits = 0;         // returns on it in this rotation (after dropouts)
   std::uint32_t raised_hits = 0;  // of those, the ones kRaisedM or more above the field surface under them
-  double distance_m = 0.0;   // horizontal, sensor origin -> nearest point of `box`
+  double distance_m = 0.0;        // horizontal, sensor origin -> nearest point of `box`
 };
 
 struct FrameTruth {
   std::uint64_t frame = 0;
   std::int64_t stamp_ns = 0;  // pcap time of the rotation's first packet
   double period_s = 0.0;
-  double roll_deg = 0.0;      // attitude at mid-rotation (R = Ry(pitch) Rx(roll), sensor -> level world)
+  double roll_deg = 0.0;  // attitude at mid-rotation (R = Ry(pitch) Rx(roll), sensor -> level world)
   double pitch_deg = 0.0;
-  Vec3 sensor_world;          // sensor position at mid-rotation (world frame)
+  Vec3 sensor_world;                 // sensor position at mid-rotation (world frame)
   std::vector<ObjectTruth> objects;  // real objects within the sensor's range, also those with no hits
   std::vector<ObjectTruth> terrain;  // clods, ridge segments, crops and the body that have hits
   std::uint64_t returns = 0;         // points in the rotation
@@ -81,10 +81,10 @@ class Simulator {
  private:
   // What one thread gathers over its packets of a rotation.
   struct Tally {
-    std::vector<std::uint32_t> hits;  // by ray-caster target
+    std::vector<std::uint32_t> hits;    // by ray-caster target
     std::vector<std::uint32_t> raised;  // by ray-caster target: hits kRaisedM or more above the surface
     std::uint64_t returns = 0;
-    SceneObject moving;               // this thread's copy of the pedestrian
+    SceneObject moving;  // this thread's copy of the pedestrian
   };
   void prepare_bins(std::int64_t t0_ns, std::int64_t t1_ns);
   void simulate_packet(std::uint64_t packet, std::uint64_t in_rotation, TimedPacket& out, Tally& tally) const;

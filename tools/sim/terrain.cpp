@@ -48,8 +48,8 @@ Terrain::Terrain(const TerrainParams& params, const TerrainExtent& extent, std::
     for (int i = 0; i < nx_; ++i) {
       const double x = extent.x_min + kCellM * i;
       const double y = extent.y_min + kCellM * j;
-      const double amp = params.furrow_amplitude_m *
-                         std::max(0.0, 1.0 + params.furrow_variation * value_noise(noise_seed, x, y));
+      const double amp =
+          params.furrow_amplitude_m * std::max(0.0, 1.0 + params.furrow_variation * value_noise(noise_seed, x, y));
       grid_[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(i)] =
           Cell{analytic_base(x, y), amp};
       max_amp = std::max(max_amp, amp);
@@ -82,13 +82,15 @@ Terrain::Terrain(const TerrainParams& params, const TerrainExtent& extent, std::
       const auto at = [&](int a, int b) -> const Cell& {
         return grid_[static_cast<std::size_t>(b) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(a)];
       };
-      const double gx = std::max(std::abs(at(i + 1, j).base - at(i, j).base),
-                                 std::abs(at(i + 1, j + 1).base - at(i, j + 1).base));
-      const double gy = std::max(std::abs(at(i, j + 1).base - at(i, j).base),
-                                 std::abs(at(i + 1, j + 1).base - at(i + 1, j).base));
+      const double gx =
+          std::max(std::abs(at(i + 1, j).base - at(i, j).base), std::abs(at(i + 1, j + 1).base - at(i, j + 1).base));
+      const double gy =
+          std::max(std::abs(at(i, j + 1).base - at(i, j).base), std::abs(at(i + 1, j + 1).base - at(i + 1, j).base));
       max_base = std::max(max_base, std::hypot(gx, gy));
-      const double ax = std::max(std::abs(at(i + 1, j).amp - at(i, j).amp), std::abs(at(i + 1, j + 1).amp - at(i, j + 1).amp));
-      const double ay = std::max(std::abs(at(i, j + 1).amp - at(i, j).amp), std::abs(at(i + 1, j + 1).amp - at(i + 1, j).amp));
+      const double ax =
+          std::max(std::abs(at(i + 1, j).amp - at(i, j).amp), std::abs(at(i + 1, j + 1).amp - at(i, j + 1).amp));
+      const double ay =
+          std::max(std::abs(at(i, j + 1).amp - at(i, j).amp), std::abs(at(i + 1, j + 1).amp - at(i + 1, j).amp));
       max_amp_grad = std::max(max_amp_grad, std::hypot(ax, ay));
     }
   }
@@ -185,9 +187,9 @@ bool Terrain::intersect(const Ray& ray, double tmax, double& t_hit) const {
   const Vec3 o = ray.origin;
   const Vec3 d = ray.dir;
   const double dxy = std::sqrt(d.x * d.x + d.y * d.y);
-  const double climb_far = -d.z + base_slope_ * dxy;    // how fast the ray can close on the envelope
+  const double climb_far = -d.z + base_slope_ * dxy;      // how fast the ray can close on the envelope
   const double climb_near = -d.z + surface_slope_ * dxy;  // ... on the surface
-  if (climb_far <= 1e-9) return false;  // the ray rises faster than the ground ever can
+  if (climb_far <= 1e-9) return false;                    // the ray rises faster than the ground ever can
   auto min_step = [](double t) { return std::max(0.02, 0.003 * t); };
   // Inside the furrow envelope: at least ~10 cm of ground or 4 cm of height per sample (a crest narrower
   // than that can be clipped; the range noise is larger than what that changes).

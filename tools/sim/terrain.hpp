@@ -77,13 +77,13 @@ class Terrain {
   TerrainExtent extent_;
   int nx_ = 0;
   int ny_ = 0;
-  std::vector<Cell> grid_;                // (nx_ x ny_) nodes, 1 m apart
-  std::vector<double> profile_;           // one furrow period, kProfileSize + 1 samples in [-1, 1]
-  double dir_x_ = 0.0;                    // unit vector across the furrows
+  std::vector<Cell> grid_;       // (nx_ x ny_) nodes, 1 m apart
+  std::vector<double> profile_;  // one furrow period, kProfileSize + 1 samples in [-1, 1]
+  double dir_x_ = 0.0;           // unit vector across the furrows
   double dir_y_ = 1.0;
-  double base_slope_ = 0.0;               // bound on |grad base|
-  double surface_slope_ = 0.0;            // bound on |grad height|
-  double envelope_ = 0.0;                 // bound on |height - base|
+  double base_slope_ = 0.0;     // bound on |grad base|
+  double surface_slope_ = 0.0;  // bound on |grad height|
+  double envelope_ = 0.0;       // bound on |height - base|
 };
 
 }  // namespace fieldguard::sim

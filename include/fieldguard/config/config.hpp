@@ -37,11 +37,11 @@ struct Scan2dConfig {
   bool enabled = false;
   std::string host = "192.168.0.10";
   std::uint16_t port = 10940;
-  int start_step = 0;               // 0..1080, front at 540
+  int start_step = 0;  // 0..1080, front at 540
   int end_step = 1080;
-  bool intensity = false;           // ME (range + intensity) instead of MD
+  bool intensity = false;  // ME (range + intensity) instead of MD
   double connect_timeout_s = 2.0;
-  double silence_timeout_s = 0.5;   // a UTM-30LX-EW streams 40 scans a second
+  double silence_timeout_s = 0.5;  // a UTM-30LX-EW streams 40 scans a second
   double backoff_max_s = 5.0;
   Mounting mounting;
 };
@@ -73,8 +73,8 @@ struct Config {
   Scan2dConfig scan2d;
   GnssConfig gnss;
   AhrsConfig ahrs;
-  SyncConfig sync;                // frames from the sensors' streams
-  GeoConfig geo;                  // pose compensation
+  SyncConfig sync;  // frames from the sensors' streams
+  GeoConfig geo;    // pose compensation
   perception::PipelineParams perception;
   output::safety::Params safety;  // the stop decision
   PipelineConfig pipeline;        // the perception worker pool
@@ -85,9 +85,9 @@ struct Config {
 // One problem found in a configuration file.
 struct ConfigIssue {
   std::string file;
-  int line = 0;           // 1-based; 0 when the problem is not tied to a line
-  std::string key_path;   // "perception.roi.min"
-  std::string message;    // what is wrong and what to do about it
+  int line = 0;                                 // 1-based; 0 when the problem is not tied to a line
+  std::string key_path;                         // "perception.roi.min"
+  std::string message;                          // what is wrong and what to do about it
   [[nodiscard]] std::string to_string() const;  // "file:line: key.path: message"
 };
 

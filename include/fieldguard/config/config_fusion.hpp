@@ -15,10 +15,10 @@ namespace fieldguard::app {
 // them: live, when scan2d, gnss or ahrs is enabled; in replay, when their byte logs are given. A 3D LiDAR
 // alone gives one frame per rotation in its sensor frame, as before fusion existed.
 struct SyncConfig {
-  double rate_hz = 5.0;             // frames a second, each made of whole rotations
-  double timeout_s = 0.5;           // a frame still waiting for a sensor this long after its window goes out
-  double max_scan_offset_s = 0.1;   // the 2D scan nearest the window's middle, if at most this far
-  int max_pending = 8;              // windows waiting for late sensors; beyond it the oldest goes out
+  double rate_hz = 5.0;            // frames a second, each made of whole rotations
+  double timeout_s = 0.5;          // a frame still waiting for a sensor this long after its window goes out
+  double max_scan_offset_s = 0.1;  // the 2D scan nearest the window's middle, if at most this far
+  int max_pending = 8;             // windows waiting for late sensors; beyond it the oldest goes out
 };
 
 struct GeoConfig {
@@ -27,8 +27,8 @@ struct GeoConfig {
   geo::AhrsFrame ahrs_frame = geo::AhrsFrame::Enu;  // what the AHRS outputs (an MTData2 packet says it too)
   double declination_deg = 0.0;                     // east positive; 0 for a GNSS-aided (true north) AHRS
   int min_gnss_quality = 1;  // GGA fix quality ranked by precision (1 GPS < 2 DGPS = 3 PPS < 5 RTK float < 4 RTK fixed)
-  double max_attitude_gap_s = 0.05;                 // AHRS samples farther apart: a dropout, points dropped
-  double max_position_gap_s = 0.5;                  // GNSS fixes farther apart: a dropout
+  double max_attitude_gap_s = 0.05;  // AHRS samples farther apart: a dropout, points dropped
+  double max_position_gap_s = 0.5;   // GNSS fixes farther apart: a dropout
 };
 
 }  // namespace fieldguard::app

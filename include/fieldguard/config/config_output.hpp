@@ -16,21 +16,22 @@ enum class PipelineDrop : std::uint8_t { Oldest, Newest };
 
 // The lock-free hand-off from the io thread to the perception workers (sync::OrderedPool).
 struct PipelineConfig {
-  int workers = 1;          // perception threads, 1..64
-  int queue_capacity = 8;   // rotations waiting for a worker, 1..4096
+  int workers = 1;                           // perception threads, 1..64
+  int queue_capacity = 8;                    // rotations waiting for a worker, 1..4096
   PipelineDrop drop = PipelineDrop::Oldest;  // live, a full queue drops (and counts) this one; replay never drops
 };
 
 // How the daemon's threads are scheduled (`realtime:`). Each setting is optional: one the system refuses is
 // logged once and the daemon runs on without it.
 struct RealtimeConfig {
-  sync::SchedPolicy policy = sync::SchedPolicy::Other;  // fifo | rr: real-time scheduling for the io thread and the workers
-  int io_priority = 50;                     // 1..99, under fifo | rr
-  int worker_priority = 40;                 // 1..99, under fifo | rr
-  std::vector<int> io_cpus;                 // CPU affinity of the io thread; empty: any
-  std::vector<int> worker_cpus;             // CPU affinity of the perception workers; empty: any
-  bool lock_memory = false;                 // mlockall(MCL_CURRENT | MCL_FUTURE)
-  double latency_budget_ms = 10.0;          // a frame decided later than this after it was whole counts as late
+  sync::SchedPolicy policy =
+      sync::SchedPolicy::Other;     // fifo | rr: real-time scheduling for the io thread and the workers
+  int io_priority = 50;             // 1..99, under fifo | rr
+  int worker_priority = 40;         // 1..99, under fifo | rr
+  std::vector<int> io_cpus;         // CPU affinity of the io thread; empty: any
+  std::vector<int> worker_cpus;     // CPU affinity of the perception workers; empty: any
+  bool lock_memory = false;         // mlockall(MCL_CURRENT | MCL_FUTURE)
+  double latency_budget_ms = 10.0;  // a frame decided later than this after it was whole counts as late
 };
 
 enum class CanSinkKind : std::uint8_t { SocketCan, Candump, None };
@@ -40,12 +41,12 @@ enum class SpeedInput : std::uint8_t { None, Ccvs1, IsoWheelBased };
 
 struct CanConfig {
   CanSinkKind sink = CanSinkKind::SocketCan;
-  std::string interface = "can0";   // the SocketCAN interface; also the interface name written in a candump log
-  std::string log_path;             // sink candump: the log file (relative paths from the config file's folder)
-  output::CanParams params;         // source and controller addresses, obstacle messages per frame
-  double heartbeat_period_s = 0.1;  // heartbeat (and repeated stop request) period
+  std::string interface = "can0";       // the SocketCAN interface; also the interface name written in a candump log
+  std::string log_path;                 // sink candump: the log file (relative paths from the config file's folder)
+  output::CanParams params;             // source and controller addresses, obstacle messages per frame
+  double heartbeat_period_s = 0.1;      // heartbeat (and repeated stop request) period
   SpeedInput speed = SpeedInput::None;  // read from `interface` (SocketCAN) by the daemon
-  double speed_timeout_s = 0.5;     // an older speed is unknown: the zone has its full-speed length
+  double speed_timeout_s = 0.5;         // an older speed is unknown: the zone has its full-speed length
 };
 
 }  // namespace fieldguard::app

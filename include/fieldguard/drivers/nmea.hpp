@@ -22,12 +22,12 @@ namespace fieldguard::nmea {
 inline constexpr std::size_t kMaxSentenceLength = 120;
 
 enum class Error : std::uint8_t {
-  NoStart,        // does not start with '$'
-  TooLong,        // longer than kMaxSentenceLength
-  BadChecksum,    // '*hh' present and wrong (or not at the end)
-  NoChecksum,     // no '*hh' (an error unless the caller accepts unchecked sentences, see StreamOptions)
-  BadField,       // a field that must be a number (or a given letter) is not, or too few fields
-  Unsupported,    // a sentence type we do not decode
+  NoStart,      // does not start with '$'
+  TooLong,      // longer than kMaxSentenceLength
+  BadChecksum,  // '*hh' present and wrong (or not at the end)
+  NoChecksum,   // no '*hh' (an error unless the caller accepts unchecked sentences, see StreamOptions)
+  BadField,     // a field that must be a number (or a given letter) is not, or too few fields
+  Unsupported,  // a sentence type we do not decode
 };
 [[nodiscard]] std::string_view to_string(Error e);
 
@@ -35,17 +35,17 @@ enum class Error : std::uint8_t {
 [[nodiscard]] std::uint8_t checksum(std::string_view body);
 
 struct Rmc {
-  std::string talker;                      // "GP", "GN", ...
+  std::string talker;  // "GP", "GN", ...
   std::optional<double> utc_seconds_of_day;
-  bool valid = false;                      // status 'A'
-  char status = 0;                         // 'A' valid, 'V' warning, 0 if the field is empty
-  std::optional<double> lat_deg;           // south negative
-  std::optional<double> lon_deg;           // west negative
+  bool valid = false;             // status 'A'
+  char status = 0;                // 'A' valid, 'V' warning, 0 if the field is empty
+  std::optional<double> lat_deg;  // south negative
+  std::optional<double> lon_deg;  // west negative
   std::optional<double> speed_mps;
   std::optional<double> course_deg;
-  std::optional<int> day, month, year;     // year as 4 digits (2-digit years are 1980..2079)
+  std::optional<int> day, month, year;           // year as 4 digits (2-digit years are 1980..2079)
   std::optional<double> magnetic_variation_deg;  // east positive, west negative
-  char mode = 0;                           // NMEA >= 2.3 mode indicator, 0 if absent
+  char mode = 0;                                 // NMEA >= 2.3 mode indicator, 0 if absent
 };
 
 struct Gga {
@@ -58,18 +58,18 @@ struct Gga {
   std::optional<int> quality;
   std::optional<int> satellites;
   std::optional<double> hdop;
-  std::optional<double> alt_m;             // above mean sea level
-  std::optional<double> geoid_sep_m;       // ellipsoidal height = alt_m + geoid_sep_m
+  std::optional<double> alt_m;        // above mean sea level
+  std::optional<double> geoid_sep_m;  // ellipsoidal height = alt_m + geoid_sep_m
   std::optional<double> dgps_age_s;
-  std::string dgps_station;                // as sent ("0133"), empty if absent
+  std::string dgps_station;  // as sent ("0133"), empty if absent
 };
 
 struct Vtg {
   std::string talker;
   std::optional<double> course_true_deg;
   std::optional<double> course_magnetic_deg;
-  std::optional<double> speed_mps;         // from the knots field, or from km/h when knots is empty
-  char mode = 0;                           // NMEA >= 2.3 mode indicator, 0 if absent
+  std::optional<double> speed_mps;  // from the knots field, or from km/h when knots is empty
+  char mode = 0;                    // NMEA >= 2.3 mode indicator, 0 if absent
 };
 
 // HDT, heading true (deprecated in favour of THS).
@@ -82,7 +82,7 @@ struct Hdt {
 struct Ths {
   std::string talker;
   std::optional<double> heading_deg;
-  char mode = 0;                           // A autonomous, E estimated, M manual, S simulator, V invalid; 0 if empty
+  char mode = 0;  // A autonomous, E estimated, M manual, S simulator, V invalid; 0 if empty
 };
 
 using Sentence = std::variant<Gga, Rmc, Vtg, Hdt, Ths>;

@@ -67,7 +67,7 @@ class StreamParser {
   bool in_sentence_ = false;
   bool in_comment_ = false;    // in a line that started with '#'
   bool at_line_start_ = true;  // the next byte starts a line
-  bool overflow_ = false;  // the current sentence outgrew buf_: it is dropped at its end
+  bool overflow_ = false;      // the current sentence outgrew buf_: it is dropped at its end
   StreamCounters counters_;
 };
 

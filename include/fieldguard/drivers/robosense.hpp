@@ -36,8 +36,8 @@ inline constexpr std::uint16_t kDefaultDifopPort = 7788;
 // 55.52 us; channel c fires kFiringOffsetUs[c] after the block's first firing.
 inline constexpr double kBlockDurationUs = 55.52;
 inline constexpr std::array<double, kChannels> kFiringOffsetUs = {
-    0.00,  2.88,  5.76,  8.64,  11.52, 14.40, 17.28, 20.16, 23.04, 25.92, 28.80, 31.68, 34.56, 37.44, 40.32, 44.64,
-    1.44,  4.32,  7.20,  10.08, 12.96, 15.84, 18.72, 21.60, 24.48, 27.36, 30.24, 33.12, 36.00, 38.88, 41.76, 46.08};
+    0.00, 2.88, 5.76, 8.64,  11.52, 14.40, 17.28, 20.16, 23.04, 25.92, 28.80, 31.68, 34.56, 37.44, 40.32, 44.64,
+    1.44, 4.32, 7.20, 10.08, 12.96, 15.84, 18.72, 21.60, 24.48, 27.36, 30.24, 33.12, 36.00, 38.88, 41.76, 46.08};
 inline constexpr double kOpticalCentreOffsetM = 0.03997;  // rs_driver RS-32 "RX" [single-source]
 
 // DIFOP byte 300 (rs_driver decoder_RS32.hpp getEchoMode, ros_rslidar rawdata.cc processDifop).
@@ -90,7 +90,7 @@ struct Calibration {
 
 // What a DIFOP packet says (protocols.md §2.3).
 struct DifopInfo {
-  std::uint16_t rpm = 0;              // 300 / 600 / 1200; 0 if unset
+  std::uint16_t rpm = 0;  // 300 / 600 / 1200; 0 if unset
   std::uint16_t fov_start_cdeg = 0;
   std::uint16_t fov_end_cdeg = 0;
   std::array<std::uint8_t, 5> top_firmware{};
@@ -109,11 +109,11 @@ struct DifopInfo {
 
 // What an MSOP packet says about itself, readable without a calibration.
 struct MsopHeader {
-  Stamp sensor_time;           // UTC of the packet's first firing (manual appendix A)
+  Stamp sensor_time;            // UTC of the packet's first firing (manual appendix A)
   std::uint8_t model_byte = 0;  // byte 30
-  float temperature_c = 0.F;   // bytes 38..39, 0.0625 degC per LSB (rs_driver parseTempInLe, ros_rslidar)
+  float temperature_c = 0.F;    // bytes 38..39, 0.0625 degC per LSB (rs_driver parseTempInLe, ros_rslidar)
   std::array<std::uint16_t, kBlocksPerPacket> azimuth_cdeg{};
-  bool dual_layout = false;    // blocks 2k and 2k+1 carry the same azimuth
+  bool dual_layout = false;  // blocks 2k and 2k+1 carry the same azimuth
 };
 
 // Validates length, magic, block flags, azimuths and the timestamp.
@@ -122,8 +122,8 @@ struct MsopHeader {
 struct DecoderOptions {
   std::optional<Calibration> calibration;  // a configured table (the unit's angle.csv); it wins over DIFOP's
   DistanceUnitOption distance_unit = DistanceUnitOption::Auto;
-  std::optional<ReturnMode> return_mode;   // none = from DIFOP; before one, from the block layout
-  double min_range_m = 0.4;                // rs_driver's RS-32 distance section: 0.4 .. 230 m
+  std::optional<ReturnMode> return_mode;  // none = from DIFOP; before one, from the block layout
+  double min_range_m = 0.4;               // rs_driver's RS-32 distance section: 0.4 .. 230 m
   double max_range_m = 230.0;
   double optical_centre_offset_m = kOpticalCentreOffsetM;
 };

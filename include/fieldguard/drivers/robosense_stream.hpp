@@ -22,14 +22,14 @@ struct StreamOptions {
 };
 
 struct StreamCounters {
-  std::uint64_t msop_packets = 0;                          // MSOP packets pushed
-  std::uint64_t msop_decoded = 0;                          // MSOP packets that yielded points (or none in range)
+  std::uint64_t msop_packets = 0;                              // MSOP packets pushed
+  std::uint64_t msop_decoded = 0;                              // MSOP packets that yielded points (or none in range)
   std::array<std::uint64_t, kDecodeErrorCount> msop_errors{};  // by DecodeError (NoCalibration: before DIFOP)
-  std::uint64_t difop_packets = 0;                         // DIFOP packets pushed
-  std::uint64_t difop_accepted = 0;                        // DIFOP packets parsed and applied
+  std::uint64_t difop_packets = 0;                             // DIFOP packets pushed
+  std::uint64_t difop_accepted = 0;                            // DIFOP packets parsed and applied
   std::array<std::uint64_t, kDecodeErrorCount> difop_errors{};
-  std::uint64_t difop_without_angles = 0;   // DIFOP whose angle table is not written
-  std::uint64_t difop_angle_changes = 0;    // DIFOP whose table differs from the one in use (kept: the first)
+  std::uint64_t difop_without_angles = 0;  // DIFOP whose angle table is not written
+  std::uint64_t difop_angle_changes = 0;   // DIFOP whose table differs from the one in use (kept: the first)
   std::uint64_t points = 0;
   std::uint64_t full_rotations = 0;
   std::uint64_t partial_rotations = 0;

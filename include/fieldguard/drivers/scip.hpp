@@ -31,11 +31,21 @@ void encode_chars(std::uint32_t value, std::size_t width, std::string& out);
 enum class Command : std::uint8_t {
   Unknown = 0,
   Scip20,  // "SCIP2.0": switch a SCIP 1.1 sensor to 2.0
-  VV, PP, II,  // version, parameters, state
-  BM, QT, RS, RT, RB,  // laser on, laser off / stop, reset, partial reset, reboot
+  VV,
+  PP,
+  II,  // version, parameters, state
+  BM,
+  QT,
+  RS,
+  RT,
+  RB,  // laser on, laser off / stop, reset, partial reset, reboot
   TM,  // time-sync mode (TM0 / TM1 / TM2)
-  MD, ME, MS,  // continuous scans: 3-char ranges, ranges + intensities, 2-char ranges
-  GD, GE, GS,  // single scans
+  MD,
+  ME,
+  MS,  // continuous scans: 3-char ranges, ranges + intensities, 2-char ranges
+  GD,
+  GE,
+  GS,  // single scans
 };
 [[nodiscard]] std::string_view to_string(Command c);
 // The command an echo line names, if the echo has exactly that command's form (fixed-width digits, then an
@@ -46,11 +56,11 @@ inline constexpr std::size_t kMaxTagLength = 16;
 
 // Parameters of MD/ME/MS (all five) and GD/GE/GS (steps and cluster).
 struct ScanRequest {
-  std::uint16_t first_step = 0;   // 0..9999 on the wire; the UTM-30LX-EW has 0..1080
+  std::uint16_t first_step = 0;  // 0..9999 on the wire; the UTM-30LX-EW has 0..1080
   std::uint16_t last_step = 1080;
-  std::uint8_t cluster = 1;       // 0..99 adjacent steps merged into one value (0 and 1 both mean none)
-  std::uint8_t interval = 0;      // 0..9 scans skipped between two sent
-  std::uint8_t scans = 0;         // 0..99 scans to send, 0 = until QT
+  std::uint8_t cluster = 1;   // 0..99 adjacent steps merged into one value (0 and 1 both mean none)
+  std::uint8_t interval = 0;  // 0..9 scans skipped between two sent
+  std::uint8_t scans = 0;     // 0..99 scans to send, 0 = until QT
   friend bool operator==(const ScanRequest&, const ScanRequest&) = default;
 };
 
@@ -59,7 +69,7 @@ struct ScanRequest {
 // character that is not printable ASCII or is ';'.
 [[nodiscard]] std::string encode_command(Command c, std::string_view tag = {});  // SCIP2.0 VV PP II BM QT RS RT RB
 [[nodiscard]] std::string encode_scan(Command c, const ScanRequest& r, std::string_view tag = {});  // MD ME MS GD GE GS
-[[nodiscard]] std::string encode_tm(int mode, std::string_view tag = {});  // TM0 / TM1 / TM2
+[[nodiscard]] std::string encode_tm(int mode, std::string_view tag = {});                           // TM0 / TM1 / TM2
 
 // ---- Status codes (§3.4; SCIP 2.0 spec C-42-03320B; hokuyolx statuses.py for the generic ones).
 enum class StatusCategory : std::uint8_t {
@@ -81,16 +91,16 @@ enum class StatusCategory : std::uint8_t {
 
 // ---- Errors, counted by whoever meets them (parser: framing; decoders: contents).
 enum class Error : std::uint8_t {
-  BadCheckCode,    // a line's check character does not match
-  MalformedLine,   // an echo that is no known command, a status line of the wrong length, a missing status
-  UnknownStatus,   // a well-formed status that is no known code
-  LineTooLong,     // a line longer than any legal one (kMaxLineLength)
-  ReplyTooLong,    // a reply longer than the longest legal ME reply (kMaxReplyBytes)
-  NotThisReply,    // decoding a reply as what it is not (a scan from an MD acknowledgement, PP from VV...)
-  BadEcho,         // the echo's fixed-width parameters are not numbers
-  BadCharacter,    // a data character outside '0'..'o'
-  BadDataLength,   // data lines not 64 characters, length not a whole number of values, wrong number of values
-  BadField,        // a VV/PP/II line that is not LABEL:value, or a PP field missing or not a number
+  BadCheckCode,   // a line's check character does not match
+  MalformedLine,  // an echo that is no known command, a status line of the wrong length, a missing status
+  UnknownStatus,  // a well-formed status that is no known code
+  LineTooLong,    // a line longer than any legal one (kMaxLineLength)
+  ReplyTooLong,   // a reply longer than the longest legal ME reply (kMaxReplyBytes)
+  NotThisReply,   // decoding a reply as what it is not (a scan from an MD acknowledgement, PP from VV...)
+  BadEcho,        // the echo's fixed-width parameters are not numbers
+  BadCharacter,   // a data character outside '0'..'o'
+  BadDataLength,  // data lines not 64 characters, length not a whole number of values, wrong number of values
+  BadField,       // a VV/PP/II line that is not LABEL:value, or a PP field missing or not a number
 };
 [[nodiscard]] std::string_view to_string(Error e);
 inline constexpr std::size_t kErrorCount = 10;
@@ -112,11 +122,11 @@ inline constexpr std::size_t kMaxLineLength = 128;
 inline constexpr std::size_t kMaxReplyBytes = max_reply_bytes();
 
 struct Reply {
-  std::string echo;                 // the command line as echoed (without LF)
+  std::string echo;  // the command line as echoed (without LF)
   Command command = Command::Unknown;
-  std::string status;               // "00", "99", "0E", ... ("0" for a SCIP 1.1 sensor)
+  std::string status;  // "00", "99", "0E", ... ("0" for a SCIP 1.1 sensor)
   StatusCategory category = StatusCategory::Ok;
-  std::vector<std::string> lines;   // payload lines, check character verified and removed
+  std::vector<std::string> lines;  // payload lines, check character verified and removed
 };
 
 struct ParserCounters {

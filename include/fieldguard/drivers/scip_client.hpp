@@ -44,10 +44,10 @@ struct Refusal {
 
 // What the caller does with one reply. At most one of scan / refused is set.
 struct ClientEvent {
-  std::string send;                    // command line to send next (LF-terminated), empty = nothing
-  std::optional<Scan> scan;            // a decoded scan (Streaming, and scans still arriving while stopping)
-  std::optional<Refusal> refused;      // the client is Failed; send nothing more, reconnect or reset
-  std::optional<Error> error;          // a scan or info reply whose contents could not be decoded (counted)
+  std::string send;                          // command line to send next (LF-terminated), empty = nothing
+  std::optional<Scan> scan;                  // a decoded scan (Streaming, and scans still arriving while stopping)
+  std::optional<Refusal> refused;            // the client is Failed; send nothing more, reconnect or reset
+  std::optional<Error> error;                // a scan or info reply whose contents could not be decoded (counted)
   std::optional<std::string> sensor_status;  // a scan reply with 21..49, 50..97 or 98 instead of 99
 };
 
@@ -75,9 +75,9 @@ class Client {
   ClientEvent on_reply(const Reply& reply);
 
   [[nodiscard]] ClientState state() const { return state_; }
-  [[nodiscard]] const InfoMap& version() const { return version_; }       // VV
+  [[nodiscard]] const InfoMap& version() const { return version_; }                          // VV
   [[nodiscard]] const std::optional<Parameters>& parameters() const { return parameters_; }  // PP
-  [[nodiscard]] const InfoMap& sensor_state() const { return sensor_state_; }  // II
+  [[nodiscard]] const InfoMap& sensor_state() const { return sensor_state_; }                // II
   [[nodiscard]] Geometry geometry() const;  // from PP, or the UTM-30LX-EW's defaults before it
   [[nodiscard]] const ClientCounters& counters() const { return counters_; }
   [[nodiscard]] const std::optional<Refusal>& failure() const { return failure_; }

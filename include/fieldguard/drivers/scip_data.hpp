@@ -23,13 +23,13 @@ using InfoMap = std::map<std::string, std::string, std::less<>>;
 
 // PP, typed. Defaults are the UTM-30LX-EW's reply.
 struct Parameters {
-  std::string model;            // MODL
-  std::uint32_t dmin_mm = 23;   // DMIN: shorter values are error codes, not distances
+  std::string model;              // MODL
+  std::uint32_t dmin_mm = 23;     // DMIN: shorter values are error codes, not distances
   std::uint32_t dmax_mm = 60000;  // DMAX
-  std::uint32_t ares = 1440;    // ARES: steps in a full turn
-  std::uint32_t amin = 0;       // AMIN: first measurable step
-  std::uint32_t amax = 1080;    // AMAX: last measurable step
-  std::uint32_t afrt = 540;     // AFRT: step of the front
+  std::uint32_t ares = 1440;      // ARES: steps in a full turn
+  std::uint32_t amin = 0;         // AMIN: first measurable step
+  std::uint32_t amax = 1080;      // AMAX: last measurable step
+  std::uint32_t afrt = 540;       // AFRT: step of the front
   std::uint32_t scan_rpm = 2400;  // SCAN
 };
 // BadField when DMIN..SCAN is missing or not a decimal number, or the values contradict each other
@@ -40,12 +40,12 @@ struct Parameters {
 // cluster, as urg_c urg_index2rad and hokuyolx get_angles count them).
 struct Scan {
   Command command = Command::MD;
-  std::uint32_t timestamp_ms = 0;   // sensor clock, 24 bits: wraps every 16 777.216 s
+  std::uint32_t timestamp_ms = 0;  // sensor clock, 24 bits: wraps every 16 777.216 s
   std::uint16_t first_step = 0;
   std::uint16_t last_step = 0;
-  std::uint8_t cluster = 1;         // 1..99 (an echoed 0 reads as 1)
+  std::uint8_t cluster = 1;          // 1..99 (an echoed 0 reads as 1)
   std::uint8_t remaining_scans = 0;  // MD/ME/MS echo: scans still to come (0 with a request of 0 = until QT)
-  std::string status;               // "99" for MD/ME/MS, "00" for GD/GE/GS
+  std::string status;                // "99" for MD/ME/MS, "00" for GD/GE/GS
   std::vector<std::uint32_t> ranges_mm;
   std::vector<std::uint32_t> intensities;  // ME/GE only
   [[nodiscard]] std::uint16_t step_of(std::size_t i) const {
@@ -74,8 +74,8 @@ struct Geometry {
 [[nodiscard]] double step_angle_deg(double step, const Geometry& g = {});
 
 struct Point2 {
-  float x_m = 0.F;        // forward
-  float y_m = 0.F;        // left
+  float x_m = 0.F;  // forward
+  float y_m = 0.F;  // left
   float range_m = 0.F;
   float angle_rad = 0.F;  // counter-clockwise from x
   std::uint16_t step = 0;

@@ -15,12 +15,12 @@
 namespace fieldguard::scip {
 
 struct SessionEvents {
-  std::string send;                      // command lines to send now (concatenated), empty = nothing
+  std::string send;  // command lines to send now (concatenated), empty = nothing
   std::vector<Scan> scans;
-  std::vector<Refusal> refusals;         // the sensor refused a command: the caller drops the connection
+  std::vector<Refusal> refusals;  // the sensor refused a command: the caller drops the connection
   std::vector<std::string> sensor_status;
   std::uint64_t decode_errors = 0;
-  std::uint64_t parser_errors = 0;       // new framing errors in these bytes
+  std::uint64_t parser_errors = 0;  // new framing errors in these bytes
 };
 
 class Session {

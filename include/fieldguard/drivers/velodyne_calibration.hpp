@@ -13,13 +13,13 @@ namespace fieldguard::velodyne {
 
 // Corrections of one laser, indexed by its slot in the firing order (laser_id in both file formats).
 struct LaserCorrection {
-  double vert_deg = 0.0;           // vertical angle, + up
-  double rot_deg = 0.0;            // azimuth correction as the files give it: SUBTRACTED from the firing azimuth
-                                   // (Velodyne manual: "positive factors rotate to the left", seen from the back)
-  double dist_m = 0.0;             // distance offset added to every range
-  double vert_offset_m = 0.0;      // vertical offset of the laser from the sensor origin
-  double horiz_offset_m = 0.0;     // horizontal offset of the laser from the sensor origin
-  double dist_x_m = 0.0;           // 2-point distance corrections (db.xml distCorrectionX/Y); kept, unused by HDL-32E
+  double vert_deg = 0.0;        // vertical angle, + up
+  double rot_deg = 0.0;         // azimuth correction as the files give it: SUBTRACTED from the firing azimuth
+                                // (Velodyne manual: "positive factors rotate to the left", seen from the back)
+  double dist_m = 0.0;          // distance offset added to every range
+  double vert_offset_m = 0.0;   // vertical offset of the laser from the sensor origin
+  double horiz_offset_m = 0.0;  // horizontal offset of the laser from the sensor origin
+  double dist_x_m = 0.0;        // 2-point distance corrections (db.xml distCorrectionX/Y); kept, unused by HDL-32E
   double dist_y_m = 0.0;
 };
 

@@ -20,11 +20,11 @@ namespace fieldguard::velodyne {
 
 // What the packet says about itself, readable without a calibration.
 struct PacketHeader {
-  std::uint32_t timestamp_us = 0;  // microseconds past the top of the hour (bytes 1200..1203)
-  std::uint8_t return_byte = 0;    // byte 1204
-  std::uint8_t product_byte = 0;   // byte 1205
+  std::uint32_t timestamp_us = 0;                  // microseconds past the top of the hour (bytes 1200..1203)
+  std::uint8_t return_byte = 0;                    // byte 1204
+  std::uint8_t product_byte = 0;                   // byte 1205
   ReturnMode return_mode = ReturnMode::Strongest;  // from byte 1204, or from the layout if it is unset
-  bool dual_layout = false;        // blocks 0 and 1 carry the same azimuth
+  bool dual_layout = false;                        // blocks 0 and 1 carry the same azimuth
   std::uint16_t first_azimuth_cdeg = 0;
   std::uint16_t last_azimuth_cdeg = 0;
 };
@@ -35,7 +35,7 @@ struct PacketHeader {
 struct DecoderOptions {
   Model model = Model::HDL32E;  // must be known here; see ModelDetector for "auto"
   TimestampReference timestamp_reference = TimestampReference::LastFiring;
-  double min_range_m = 0.5;     // returns nearer than this are dropped (0 = "no return" is always dropped)
+  double min_range_m = 0.5;  // returns nearer than this are dropped (0 = "no return" is always dropped)
   double max_range_m = 130.0;
 };
 
@@ -130,7 +130,7 @@ class Decoder {
   struct SlotTables {
     std::array<float, kSlotsPerBlock> cos_vert;
     std::array<float, kSlotsPerBlock> sin_vert;
-    std::array<float, kSlotsPerBlock> rot_cdeg;        // azimuth correction, 0.01 degree, subtracted
+    std::array<float, kSlotsPerBlock> rot_cdeg;  // azimuth correction, 0.01 degree, subtracted
     std::array<float, kSlotsPerBlock> dist_m;
     std::array<float, kSlotsPerBlock> vert_offset_m;
     std::array<float, kSlotsPerBlock> horiz_offset_m;

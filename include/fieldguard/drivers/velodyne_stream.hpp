@@ -17,18 +17,18 @@
 namespace fieldguard::velodyne {
 
 struct StreamOptions {
-  Model model = Model::Unknown;             // Unknown = detect from the stream
-  std::optional<Calibration> calibration;   // none = the built-in table of the model
+  Model model = Model::Unknown;            // Unknown = detect from the stream
+  std::optional<Calibration> calibration;  // none = the built-in table of the model
   TimestampReference timestamp_reference = TimestampReference::LastFiring;
   double min_range_m = 0.5;
   double max_range_m = 130.0;
   double rotation_cut_deg = 0.0;
-  std::size_t max_undecided_packets = 16;   // packets held while the model is being detected
+  std::size_t max_undecided_packets = 16;  // packets held while the model is being detected
 };
 
 struct StreamCounters {
-  std::uint64_t packets = 0;                         // data packets pushed
-  std::uint64_t decoded = 0;                         // packets that yielded points (or a valid empty packet)
+  std::uint64_t packets = 0;                              // data packets pushed
+  std::uint64_t decoded = 0;                              // packets that yielded points (or a valid empty packet)
   std::array<std::uint64_t, kDecodeErrorCount> errors{};  // by DecodeError
   std::uint64_t points = 0;
   std::uint64_t full_rotations = 0;

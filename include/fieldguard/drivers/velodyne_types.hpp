@@ -28,12 +28,12 @@ enum class TimestampReference : std::uint8_t { FirstFiring = 0, LastFiring };
 
 // Decode errors of data and position packets. Each is counted by the caller, never thrown.
 enum class DecodeError : std::uint8_t {
-  BadLength,       // payload is not 1206 (data) / 512 (position) bytes
-  BadBlockFlag,    // a block does not start with FF EE
-  BadAzimuth,      // an azimuth >= 36000
-  BadReturnMode,   // factory byte 1204 not 0x37/0x38/0x39 and dual layout not recognisable
-  ModelMismatch,   // packet layout contradicts the configured model
-  NoModel,         // model not configured and not yet detected from the stream
+  BadLength,      // payload is not 1206 (data) / 512 (position) bytes
+  BadBlockFlag,   // a block does not start with FF EE
+  BadAzimuth,     // an azimuth >= 36000
+  BadReturnMode,  // factory byte 1204 not 0x37/0x38/0x39 and dual layout not recognisable
+  ModelMismatch,  // packet layout contradicts the configured model
+  NoModel,        // model not configured and not yet detected from the stream
 };
 [[nodiscard]] std::string_view to_string(DecodeError e);
 inline constexpr std::size_t kDecodeErrorCount = 6;

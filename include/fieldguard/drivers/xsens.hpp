@@ -15,7 +15,7 @@
 namespace fieldguard::xsens {
 
 inline constexpr std::uint8_t kPreamble = 0xFA;
-inline constexpr std::uint8_t kBusMaster = 0xFF;     // the only bus id an MTi uses
+inline constexpr std::uint8_t kBusMaster = 0xFF;       // the only bus id an MTi uses
 inline constexpr std::uint8_t kExtendedLength = 0xFF;  // length byte announcing the 2-byte length
 // Largest payload accepted. The Xbus extended length goes to 65535, but Xsens devices send at most 2048 bytes
 // (MT Manager's EMTS dump, the longest message in the captures we have, is 1320); capping keeps the stream
@@ -55,9 +55,9 @@ inline constexpr std::uint8_t kOutputConfiguration = 0xC1;
 [[nodiscard]] std::string_view message_name(std::uint8_t mid);
 
 enum class Error : std::uint8_t {
-  TooShort,         // fewer bytes than the header or the length field says
-  BadPreamble,      // not 0xFA 0xFF
-  TooLong,          // payload length over kMaxPayload
+  TooShort,     // fewer bytes than the header or the length field says
+  BadPreamble,  // not 0xFA 0xFF
+  TooLong,      // payload length over kMaxPayload
   BadChecksum,
   NotMtData2,       // decode_mtdata2_message on another message id
   TruncatedPacket,  // an MTData2 packet (id, size, data) runs past the end of the payload

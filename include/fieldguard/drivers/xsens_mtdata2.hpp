@@ -125,14 +125,14 @@ struct MtData2 {
   CoordinateSystem rotation_matrix_frame = CoordinateSystem::Enu;
   CoordinateSystem euler_frame = CoordinateSystem::Enu;
 
-  std::optional<Vec3> delta_v;               // m/s
-  std::optional<Vec3> acceleration;          // m/s², gravity included
-  std::optional<Vec3> free_acceleration;     // m/s², gravity removed
-  std::optional<Vec3> acceleration_hr;       // m/s²
-  std::optional<Vec3> rate_of_turn;          // rad/s
+  std::optional<Vec3> delta_v;            // m/s
+  std::optional<Vec3> acceleration;       // m/s², gravity included
+  std::optional<Vec3> free_acceleration;  // m/s², gravity removed
+  std::optional<Vec3> acceleration_hr;    // m/s²
+  std::optional<Vec3> rate_of_turn;       // rad/s
   std::optional<Quat> delta_q;
-  std::optional<Vec3> rate_of_turn_hr;       // rad/s
-  std::optional<Vec3> magnetic_field;        // a.u.
+  std::optional<Vec3> rate_of_turn_hr;  // rad/s
+  std::optional<Vec3> magnetic_field;   // a.u.
   std::optional<double> temperature_c;
   std::optional<std::uint32_t> baro_pressure_pa;
 

@@ -129,13 +129,13 @@ class DetectorSet {
 };
 
 struct FusionCounts {
-  std::uint64_t frames = 0;        // jobs handed out
-  std::uint64_t scans = 0;         // 2D scans decoded
-  std::uint64_t gnss = 0;          // NMEA sentences decoded
-  std::uint64_t ahrs = 0;          // MTData2 messages decoded
-  std::uint64_t scan_errors = 0;   // SCIP framing or decoding errors
-  std::uint64_t gnss_errors = 0;   // NMEA sentences rejected
-  std::uint64_t ahrs_errors = 0;   // Xsens messages rejected
+  std::uint64_t frames = 0;       // jobs handed out
+  std::uint64_t scans = 0;        // 2D scans decoded
+  std::uint64_t gnss = 0;         // NMEA sentences decoded
+  std::uint64_t ahrs = 0;         // MTData2 messages decoded
+  std::uint64_t scan_errors = 0;  // SCIP framing or decoding errors
+  std::uint64_t gnss_errors = 0;  // NMEA sentences rejected
+  std::uint64_t ahrs_errors = 0;  // Xsens messages rejected
 };
 
 class SensorFusion {
@@ -179,10 +179,10 @@ class SensorFusion {
  private:
   struct Decoders;
   void rotations_to(Stamp host, std::vector<FrameJob>& out);
-  void frames_to(Stamp host, std::vector<FrameJob>& out);     // poll sync, then jobs_from_frames
+  void frames_to(Stamp host, std::vector<FrameJob>& out);         // poll sync, then jobs_from_frames
   void jobs_from_frames(Stamp host, std::vector<FrameJob>& out);  // frames_ out as jobs complete at `host`
-  void pass_sentences(Stamp host);  // decoded NMEA: counted, checked, to sync
-  void pass_items(Stamp host);      // decoded MTData2: likewise
+  void pass_sentences(Stamp host);                                // decoded NMEA: counted, checked, to sync
+  void pass_items(Stamp host);                                    // decoded MTData2: likewise
 
   void check(const nmea::Sentence& s, Stamp host);
   void check(const xsens::MtData2& m, Stamp host);

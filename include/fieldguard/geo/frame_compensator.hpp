@@ -70,19 +70,19 @@ namespace fieldguard::geo {
 
 struct CompensationParams {
   ProjectionParams projection;
-  AhrsParams ahrs;                                 // output frame, mounting, declination
+  AhrsParams ahrs;                                      // output frame, mounting, declination
   Eigen::Vector3d antenna_m = Eigen::Vector3d::Zero();  // GNSS antenna phase centre in the vehicle frame
-  Mounting lidar;                                  // the 3D LiDAR in the vehicle frame
-  Mounting scanner;                                // the 2D LiDAR in the vehicle frame
-  double scan_turn_period_s = 0.025;               // UTM-30LX-EW: 40 turns a second
-  scip::Geometry scan_geometry;                    // the 2D LiDAR's PP answer (defaults: UTM-30LX-EW)
+  Mounting lidar;                                       // the 3D LiDAR in the vehicle frame
+  Mounting scanner;                                     // the 2D LiDAR in the vehicle frame
+  double scan_turn_period_s = 0.025;                    // UTM-30LX-EW: 40 turns a second
+  scip::Geometry scan_geometry;                         // the 2D LiDAR's PP answer (defaults: UTM-30LX-EW)
   TrackParams track;
-  double pose_step_s = 1e-4;                       // DeskewParams::pose_step_s
+  double pose_step_s = 1e-4;  // DeskewParams::pose_step_s
   // The least GGA fix quality used, by precision, not by code: 1 GPS < 2 DGPS = 3 PPS < 5 RTK float < 4 RTK
   // fixed (4: RTK fixed only; 5: RTK float or fixed). 0 invalid, 6 estimated (dead reckoning), 7 manual
   // and 8 simulator are never positions; 1..5 are the valid settings.
   int min_gnss_quality = 1;
-  bool plane_points = false;                       // also fill CompensatedFrame::plane (recording)
+  bool plane_points = false;  // also fill CompensatedFrame::plane (recording)
 
   [[nodiscard]] std::vector<std::string> validate() const;  // "key: problem" each; empty when valid
 };
@@ -91,29 +91,29 @@ enum class Levelling : std::uint8_t { Full = 0, AttitudeOnly = 1, None = 2 };
 [[nodiscard]] const char* to_string(Levelling l);
 
 struct CompensationStats {
-  DeskewStats lidar;           // 3D LiDAR points through deskew
-  DeskewStats scan;            // lifted 2D points through deskew
+  DeskewStats lidar;  // 3D LiDAR points through deskew
+  DeskewStats scan;   // lifted 2D points through deskew
   ScanLiftStats lift;
-  std::size_t gnss_used = 0;        // fixes that went into the track
-  std::size_t gnss_rejected = 0;    // GGA without a fix, below min_gnss_quality, not projectable, out of order
+  std::size_t gnss_used = 0;      // fixes that went into the track
+  std::size_t gnss_rejected = 0;  // GGA without a fix, below min_gnss_quality, not projectable, out of order
   std::size_t ahrs_used = 0;
-  std::size_t ahrs_rejected = 0;    // no Euler angles, not finite, out of order, reserved coordinate system
+  std::size_t ahrs_rejected = 0;        // no Euler angles, not finite, out of order, reserved coordinate system
   std::size_t ahrs_frame_mismatch = 0;  // used, but the data id's frame differs from AhrsParams::frame
   std::size_t gnss_lever_nearest = 0;   // used with the nearest AHRS sample's attitude for the lever arm
 };
 
 struct CompensatedFrame {
   Levelling levelling = Levelling::None;
-  Stamp t_ref;                      // the instant of the level frame: the window's end
+  Stamp t_ref;  // the instant of the level frame: the window's end
   // Detection frame (above); 3D LiDAR points first in their input order, then the 2D scan's, each with
   // `source` set. time_s stays relative to the frame's window_start; range_m is the distance from the
   // 3D LiDAR's nominal position after compensation; ring: 3D ring, or the 2D scan's step.
   std::vector<LidarPoint> points;
-  std::vector<PlanePoint> plane;    // when params.plane_points and levelling == Full
+  std::vector<PlanePoint> plane;  // when params.plane_points and levelling == Full
   // The vehicle reference point at t_ref (levelling Full); zone, convergence and scale are those of the
   // frame's first usable fix.
   std::optional<PlaneCoord> reference;
-  std::optional<EulerDeg> attitude;     // the vehicle's attitude at t_ref, plane frame (levelling != None)
+  std::optional<EulerDeg> attitude;  // the vehicle's attitude at t_ref, plane frame (levelling != None)
   CompensationStats stats;
 };
 

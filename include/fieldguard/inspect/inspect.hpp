@@ -10,10 +10,10 @@
 namespace fieldguard::app {
 
 struct InspectOptions {
-  std::string path;                           // the capture
-  std::optional<std::string> format;          // a name of inspect_formats(); guessed from the bytes when not given
-  std::optional<std::uint16_t> data_port;     // velodyne data (2368), robosense MSOP (6699)
-  std::optional<std::uint16_t> position_port; // velodyne position (8308), robosense DIFOP (7788)
+  std::string path;                            // the capture
+  std::optional<std::string> format;           // a name of inspect_formats(); guessed from the bytes when not given
+  std::optional<std::uint16_t> data_port;      // velodyne data (2368), robosense MSOP (6699)
+  std::optional<std::uint16_t> position_port;  // velodyne position (8308), robosense DIFOP (7788)
 };
 
 // The format names `--format` takes, "a|b|...".

@@ -28,10 +28,10 @@ struct CanFilter {
 };
 
 struct CanReaderStats {
-  std::uint64_t frames = 0;      // handed to the handler
-  std::uint64_t not_ours = 0;    // standard (11-bit), remote or error frames, or ids no filter passes
-  std::uint64_t bad_size = 0;    // reads that were not one struct can_frame
-  std::uint64_t errors = 0;      // receive errors other than would-block
+  std::uint64_t frames = 0;    // handed to the handler
+  std::uint64_t not_ours = 0;  // standard (11-bit), remote or error frames, or ids no filter passes
+  std::uint64_t bad_size = 0;  // reads that were not one struct can_frame
+  std::uint64_t errors = 0;    // receive errors other than would-block
 };
 
 class CanReader {
@@ -41,7 +41,8 @@ class CanReader {
 
   // A CAN_RAW socket bound to `iface` with the kernel doing the filtering. The error says what failed and
   // what to do (no SocketCAN in the kernel, no such interface, ...).
-  [[nodiscard]] static Expected<int, std::string> open_socket(std::string_view iface, const std::vector<CanFilter>& filters);
+  [[nodiscard]] static Expected<int, std::string> open_socket(std::string_view iface,
+                                                              const std::vector<CanFilter>& filters);
 
   // Adopts `fd` (a CAN_RAW socket, or in tests one end of a socketpair carrying struct can_frame; the filters
   // are then applied here too) and closes it when destroyed.

@@ -16,12 +16,12 @@
 namespace fieldguard::io {
 
 struct PcapStats {
-  std::uint64_t records = 0;                        // records read from the file
-  std::uint64_t datagrams = 0;                      // UDP datagrams handed out
-  std::uint64_t ip_length_repaired = 0;             // of them, with an impossible IP total length
+  std::uint64_t records = 0;                           // records read from the file
+  std::uint64_t datagrams = 0;                         // UDP datagrams handed out
+  std::uint64_t ip_length_repaired = 0;                // of them, with an impossible IP total length
   std::array<std::uint64_t, kFrameDropCount> drops{};  // by FrameDrop
-  bool truncated = false;                           // the file ended inside a record
-  std::string read_error;                           // libpcap's message when reading stopped early
+  bool truncated = false;                              // the file ended inside a record
+  std::string read_error;                              // libpcap's message when reading stopped early
 };
 
 class PcapReader {

@@ -22,13 +22,13 @@ class io_context;
 namespace fieldguard::io {
 
 struct SerialOptions {
-  std::string device;               // e.g. /dev/ttyUSB0 or a /dev/serial/by-id/ link
+  std::string device;  // e.g. /dev/ttyUSB0 or a /dev/serial/by-id/ link
   unsigned baud = 115200;
-  unsigned data_bits = 8;           // 5..8
-  char parity = 'N';                // N, E or O
-  unsigned stop_bits = 1;           // 1 or 2
-  double silence_timeout_s = 1.0;   // no byte for this long = silent
-  double reopen_interval_s = 1.0;   // between attempts to (re)open the device
+  unsigned data_bits = 8;          // 5..8
+  char parity = 'N';               // N, E or O
+  unsigned stop_bits = 1;          // 1 or 2
+  double silence_timeout_s = 1.0;  // no byte for this long = silent
+  double reopen_interval_s = 1.0;  // between attempts to (re)open the device
 };
 
 enum class SerialState : std::uint8_t { Closed = 0, Open = 1, Silent = 2 };
@@ -37,10 +37,10 @@ enum class SerialState : std::uint8_t { Closed = 0, Open = 1, Silent = 2 };
 struct SerialStats {
   std::atomic<std::uint64_t> bytes{0};
   std::atomic<std::uint64_t> chunks{0};
-  std::atomic<std::uint64_t> opens{0};          // successful opens (1 + reopens)
+  std::atomic<std::uint64_t> opens{0};  // successful opens (1 + reopens)
   std::atomic<std::uint64_t> open_failures{0};
-  std::atomic<std::uint64_t> read_errors{0};    // the device went away or failed while open
-  std::atomic<std::uint64_t> silences{0};       // times it fell silent
+  std::atomic<std::uint64_t> read_errors{0};  // the device went away or failed while open
+  std::atomic<std::uint64_t> silences{0};     // times it fell silent
   std::atomic<std::int64_t> last_rx_ns{0};
   std::atomic<SerialState> state{SerialState::Closed};
 };

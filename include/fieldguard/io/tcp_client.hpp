@@ -24,8 +24,8 @@ struct TcpClientOptions {
   std::string host = "192.168.0.10";
   std::uint16_t port = 10940;
   double connect_timeout_s = 2.0;
-  double silence_timeout_s = 1.0;   // connected but no byte for this long: drop the link and reconnect
-  double backoff_initial_s = 0.1;   // first wait before reconnecting; doubles up to backoff_max_s
+  double silence_timeout_s = 1.0;  // connected but no byte for this long: drop the link and reconnect
+  double backoff_initial_s = 0.1;  // first wait before reconnecting; doubles up to backoff_max_s
   double backoff_max_s = 5.0;
 };
 
@@ -35,7 +35,7 @@ enum class TcpState : std::uint8_t { Idle = 0, Connecting = 1, Connected = 2, Ba
 struct TcpClientStats {
   std::atomic<std::uint64_t> connects{0};
   std::atomic<std::uint64_t> connect_failures{0};
-  std::atomic<std::uint64_t> disconnects{0};   // resets, end of stream, silence
+  std::atomic<std::uint64_t> disconnects{0};  // resets, end of stream, silence
   std::atomic<std::uint64_t> silences{0};
   std::atomic<std::uint64_t> bytes_in{0};
   std::atomic<std::uint64_t> bytes_out{0};
@@ -46,7 +46,7 @@ struct TcpClientStats {
 class TcpClient {
  public:
   struct Handlers {
-    std::function<void()> on_connected;                      // send the start-up commands here
+    std::function<void()> on_connected;  // send the start-up commands here
     std::function<void(ByteSpan, Stamp)> on_data;
     std::function<void(TcpState, const std::string&)> on_state;  // every change, with a one-line reason
   };

@@ -22,7 +22,7 @@ struct CanParams {
   std::uint8_t source_address = 0x80;      // ours
   std::uint8_t controller_address = 0x26;  // the steering controller's: set it to the one on the tractor's bus
   std::array<std::uint8_t, kMessageCount> priority{6, 6, 3, 6};  // by MessageId, 0 = highest
-  std::uint8_t max_obstacles = 8;          // FG_OBSTACLE messages per frame, 0..16
+  std::uint8_t max_obstacles = 8;                                // FG_OBSTACLE messages per frame, 0..16
 };
 
 // Every problem with `p`, each as "key: what is wrong and what to do"; empty when usable.

@@ -65,8 +65,16 @@ namespace obstacle_sig {
 enum : std::size_t { Index, SizeClass, XMin, XMax, YMin, YMax, Height, Points };
 }
 namespace stop_sig {
-enum : std::size_t { Command, ReasonObstacle, ReasonSensorFault, ReasonPipelineLate, ReasonStartingUp,
-                     ReasonShuttingDown, AliveCounter, Crc };
+enum : std::size_t {
+  Command,
+  ReasonObstacle,
+  ReasonSensorFault,
+  ReasonPipelineLate,
+  ReasonStartingUp,
+  ReasonShuttingDown,
+  AliveCounter,
+  Crc
+};
 }
 namespace heartbeat_sig {
 enum : std::size_t { Lidar3d, Lidar2d, Gnss, Ahrs, FramesLost, SaturatedValues, AliveCounter, Crc };

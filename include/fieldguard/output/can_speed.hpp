@@ -12,7 +12,7 @@
 
 namespace fieldguard::output {
 
-inline constexpr std::uint32_t kPgnCcvs1 = 65265;             // 0xFEF1
+inline constexpr std::uint32_t kPgnCcvs1 = 65265;               // 0xFEF1
 inline constexpr std::uint32_t kPgnIsoWheelBasedSpeed = 65096;  // 0xFE48
 
 enum class SpeedSource : std::uint8_t { Ccvs1 = 0, IsoWheelBased = 1 };

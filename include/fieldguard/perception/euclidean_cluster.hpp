@@ -106,23 +106,23 @@ class EuclideanClusterer {
   Buffer<float> grid_point_;          // x, y, z and 3D range (adaptive) of each point in grid order, side by side
   Buffer<std::uint32_t> grid_z_;      // z cell in grid order
   struct Cell {
-    std::uint32_t first;   // its points: grid order [first, next cell's first)
-    std::uint32_t col;     // x-y column
-    float reach2;          // the largest radius of its points, squared (anisotropic: the vertical one)
-    float hreach2;         // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
+    std::uint32_t first;  // its points: grid order [first, next cell's first)
+    std::uint32_t col;    // x-y column
+    float reach2;         // the largest radius of its points, squared (anisotropic: the vertical one)
+    float hreach2;        // the largest horizontal radius of its points, squared (= reach2 unless anisotropic)
   };
   static constexpr std::uint32_t kNoCluster = 0xFFFFFFFFU;
   Buffer<Cell> cells_;
-  struct ZSpan {  // per cell, apart: the neighbour scan reads only these, packed
+  struct ZSpan {           // per cell, apart: the neighbour scan reads only these, packed
     std::uint32_t iz;      // its lowest z cell
     std::uint32_t iz_top;  // its highest z cell (far out a cell stacks several: see extract_grid)
   };
   Buffer<ZSpan> cell_z_;
   Buffer<float> cell_box_;           // per cell, the box of its points (min x, y, z, -, max x, y, z, range)
   Buffer<std::uint32_t> col_cells_;  // per column: its first cell (cells of a column ascend in z)
-  struct Stencil {  // per cell: the cells it looks at (extract_grid)
-    std::uint32_t hreach;  // columns apart on x and on y
-    std::uint32_t z_lo, z_hi;  // z cells
+  struct Stencil {                   // per cell: the cells it looks at (extract_grid)
+    std::uint32_t hreach;            // columns apart on x and on y
+    std::uint32_t z_lo, z_hi;        // z cells
   };
   Buffer<Stencil> stencil_;
   Buffer<std::uint32_t> col_rep_;    // per column, once its joins are done: a cell of it if all are in one cluster

@@ -19,7 +19,7 @@ enum class SizeClass : std::uint8_t { Small = 0, Large = 1 };
 [[nodiscard]] std::string_view to_string(SizeClass c);
 
 struct Obstacle {
-  std::array<float, 3> min{};        // axis-aligned box (m)
+  std::array<float, 3> min{};  // axis-aligned box (m)
   std::array<float, 3> max{};
   // Oriented box in x-y (minimum-area rectangle of the cluster's footprint), z from the axis-aligned box.
   std::array<float, 2> obb_center{};  // (m)
@@ -31,7 +31,7 @@ struct Obstacle {
   float bearing_deg = 0.F;            // atan2(y, x) of the box centre, degrees, + to the left
   float height_above_ground_m = 0.F;  // highest point above the local ground under the cluster
   SizeClass size_class = SizeClass::Small;
-  std::uint8_t sources = kSeenBy3d;   // kSeenBy3d | kSeenBy2d: which sensors' points it holds
+  std::uint8_t sources = kSeenBy3d;  // kSeenBy3d | kSeenBy2d: which sensors' points it holds
   // Reported by ObstacleHold (obstacle_hold.hpp) from this frame's fragments where an obstacle was reported
   // lately, not by the filters: its boxes are the fragments' (axis-aligned; the oriented box is the same).
   bool held = false;
@@ -48,7 +48,12 @@ struct Fragment {
 };
 
 // Points of the processed frame with what the pipeline made of them, for pictures and debugging.
-enum class PointLabel : std::uint8_t { Ground = 0, Obstacle = 1, Rejected = 2 /* clustered, filtered out */, Unclustered = 3 };
+enum class PointLabel : std::uint8_t {
+  Ground = 0,
+  Obstacle = 1,
+  Rejected = 2 /* clustered, filtered out */,
+  Unclustered = 3
+};
 struct LabeledPoint {
   float x = 0.F;
   float y = 0.F;
@@ -59,11 +64,11 @@ struct LabeledPoint {
 // How many points each stage kept, for the summary, the benchmarks and the status.
 struct StageCounts {
   std::uint32_t input = 0;
-  std::uint32_t after_roi = 0;    // inside the ROI and outside the body box
+  std::uint32_t after_roi = 0;  // inside the ROI and outside the body box
   std::uint32_t after_voxel = 0;
   std::uint32_t ground = 0;
-  std::uint32_t clusters = 0;     // before the filters
-  std::uint32_t obstacles = 0;    // after the filters
+  std::uint32_t clusters = 0;   // before the filters
+  std::uint32_t obstacles = 0;  // after the filters
   // The 2D LiDAR's near-field path (near_field.hpp); none of its points is counted above. Obstacles
   // reported = obstacles + near_obstacles - near_merged + held.
   std::uint32_t near_input = 0;      // 2D LiDAR points in the frame
@@ -81,14 +86,14 @@ struct StageCounts {
 // and can flatter it: on the shed 5 Hz rotation the voxel grid takes 0.45 ms so and 0.55 ms here, and the
 // crop took 0.12 ms so and 0.24-0.35 ms here until it prefetched (BM_PacketsToObstacles prints these).
 struct StageTimes {
-  float crop_us = 0.F;      // ROI and body box
-  float voxel_us = 0.F;     // voxel grid
-  float ground_us = 0.F;    // ground segmentation, and the split of the voxels into ground and the rest
-  float cluster_us = 0.F;   // Euclidean clustering
-  float merge_us = 0.F;     // cluster summaries, absorption, joins and splits
-  float boxes_us = 0.F;     // the filters, and each kept cluster's boxes
-  float near_us = 0.F;      // the 2D LiDAR's near field, and the sort of the obstacles
-  float total_us = 0.F;     // all of process()
+  float crop_us = 0.F;     // ROI and body box
+  float voxel_us = 0.F;    // voxel grid
+  float ground_us = 0.F;   // ground segmentation, and the split of the voxels into ground and the rest
+  float cluster_us = 0.F;  // Euclidean clustering
+  float merge_us = 0.F;    // cluster summaries, absorption, joins and splits
+  float boxes_us = 0.F;    // the filters, and each kept cluster's boxes
+  float near_us = 0.F;     // the 2D LiDAR's near field, and the sort of the obstacles
+  float total_us = 0.F;    // all of process()
 };
 
 // Sorts by distance_m, nearest first; ties by bearing_deg, then by the box's min corner (deterministic).

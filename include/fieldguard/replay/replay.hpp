@@ -9,9 +9,9 @@
 namespace fieldguard::app {
 
 struct ReplayOptions {
-  std::string config;                  // configuration file
-  std::optional<std::string> pcap;     // the capture; exactly one of pcap and session
-  std::optional<std::string> session;  // a directory written by `fieldguard record`
+  std::string config;                                         // configuration file
+  std::optional<std::string> pcap;                            // the capture; exactly one of pcap and session
+  std::optional<std::string> session;                         // a directory written by `fieldguard record`
   std::optional<std::string> scan2d_log, gnss_log, ahrs_log;  // byte logs given one by one
   std::optional<std::string> samples_out, obstacles_out, bev_dir, pcd_dir, can_log;
   std::optional<std::size_t> workers;  // 1..64; pipeline.workers of the configuration when not given

@@ -35,14 +35,14 @@ namespace fieldguard::sync {
 
 // Roll-over periods of the sensors' counters, as raw ticks, and the length of a tick.
 struct CounterKind {
-  std::uint64_t modulus = 0;     // raw values are in [0, modulus); 0 = does not wrap (64-bit)
+  std::uint64_t modulus = 0;  // raw values are in [0, modulus); 0 = does not wrap (64-bit)
   std::int64_t tick_ns = 1;
 };
-inline constexpr CounterKind kVelodyneMicrosPastHour{3'600'000'000ULL, 1'000};       // wraps every hour
-inline constexpr CounterKind kXsensSampleTimeFine{1ULL << 32, 100'000};               // 10 kHz, ~4.97 days
-inline constexpr CounterKind kXsensPacketCounter{1ULL << 16, 1};                      // a count, not a time
-inline constexpr CounterKind kNmeaNanosOfDay{86'400'000'000'000ULL, 1};               // UTC time of day
-inline constexpr CounterKind kScipMillis{1ULL << 24, 1'000'000};                      // ~4.66 hours
+inline constexpr CounterKind kVelodyneMicrosPastHour{3'600'000'000ULL, 1'000};  // wraps every hour
+inline constexpr CounterKind kXsensSampleTimeFine{1ULL << 32, 100'000};         // 10 kHz, ~4.97 days
+inline constexpr CounterKind kXsensPacketCounter{1ULL << 16, 1};                // a count, not a time
+inline constexpr CounterKind kNmeaNanosOfDay{86'400'000'000'000ULL, 1};         // UTC time of day
+inline constexpr CounterKind kScipMillis{1ULL << 24, 1'000'000};                // ~4.66 hours
 
 // Raw counter -> monotonic ticks. A step back of up to half the modulus is a step back (a late or repeated
 // sample: it is returned as such and counted), a larger one is a wrap forward. Thread-compatible.
@@ -93,11 +93,11 @@ struct ClockParams {
 };
 
 struct Mapping {
-  Stamp mapped;          // the sample's time on the host clock
+  Stamp mapped;                  // the sample's time on the host clock
   std::int64_t residual_ns = 0;  // receive time - model time of the sample, after the sample was taken in
-  bool suspect = false;  // far off the model: mapped from the receive time, pending a jump decision
-  bool jumped = false;   // this sample confirmed a jump; the model was re-seeded
-  bool fitted = false;   // the model had at least one pair before this one (else mapped = receive time)
+  bool suspect = false;          // far off the model: mapped from the receive time, pending a jump decision
+  bool jumped = false;           // this sample confirmed a jump; the model was re-seeded
+  bool fitted = false;           // the model had at least one pair before this one (else mapped = receive time)
 };
 
 // Offset and skew of one sensor clock against the host clock. Sensor times are monotonic nanoseconds (the
@@ -112,8 +112,8 @@ class ClockModel {
   [[nodiscard]] Stamp map(std::int64_t sensor_ns) const;
 
   [[nodiscard]] bool has_model() const { return ref_.has_value(); }
-  [[nodiscard]] double skew() const { return skew_; }          // host seconds per sensor second, minus 1
-  [[nodiscard]] std::int64_t offset_ns() const;                // host - sensor at the reference point
+  [[nodiscard]] double skew() const { return skew_; }  // host seconds per sensor second, minus 1
+  [[nodiscard]] std::int64_t offset_ns() const;        // host - sensor at the reference point
   [[nodiscard]] std::uint64_t jumps() const { return jumps_; }
   [[nodiscard]] std::uint64_t pairs() const { return pairs_; }
   [[nodiscard]] std::uint64_t rejected_skews() const { return rejected_skews_; }
@@ -121,9 +121,9 @@ class ClockModel {
 
  private:
   struct Bucket {
-    std::int64_t index = 0;     // floor(sensor time / bucket width)
-    double x = 0.0;             // sensor time of the minimum, s after ref
-    double y = 0.0;             // host - sensor at the minimum, s after the reference offset
+    std::int64_t index = 0;  // floor(sensor time / bucket width)
+    double x = 0.0;          // sensor time of the minimum, s after ref
+    double y = 0.0;          // host - sensor at the minimum, s after the reference offset
   };
   struct Suspect {
     std::int64_t sensor_ns = 0;
@@ -136,10 +136,10 @@ class ClockModel {
   [[nodiscard]] double model_y(double x) const { return a_ + skew_ * x; }
 
   ClockParams params_;
-  std::optional<std::int64_t> ref_;   // sensor ns of the reference point
-  std::int64_t ref_offset_ns_ = 0;    // host - sensor of the first pair after a (re)seed
+  std::optional<std::int64_t> ref_;  // sensor ns of the reference point
+  std::int64_t ref_offset_ns_ = 0;   // host - sensor of the first pair after a (re)seed
   std::deque<Bucket> buckets_;
-  double a_ = 0.0;                    // fitted y at x = 0
+  double a_ = 0.0;  // fitted y at x = 0
   double skew_ = 0.0;
   std::deque<Suspect> suspects_;
   std::uint64_t jumps_ = 0;

@@ -42,12 +42,12 @@ struct AssemblerParams {
 
 struct AssemblerCounters {
   std::uint64_t rotations = 0;
-  std::uint64_t late_rotations = 0;   // starting before the end of an earlier one: dropped
+  std::uint64_t late_rotations = 0;  // starting before the end of an earlier one: dropped
   std::uint64_t frames = 0;
   std::uint64_t complete = 0;
   std::uint64_t timed_out = 0;
-  std::uint64_t overflowed = 0;       // emitted early because max_pending was reached
-  std::uint64_t late_samples = 0;     // older than what emitted frames already used: dropped
+  std::uint64_t overflowed = 0;              // emitted early because max_pending was reached
+  std::uint64_t late_samples = 0;            // older than what emitted frames already used: dropped
   std::uint64_t missing[kSensorCount] = {};  // frames emitted lacking each sensor
 };
 
@@ -89,13 +89,13 @@ class FrameAssembler {
 
   AssemblerParams params_;
   std::int64_t period_ns_ = 0;
-  std::vector<LidarRotation> open_;       // rotations of the window being filled
-  std::deque<Window> pending_;            // closed, waiting for the other sensors
-  std::deque<TimedScan> scans_;           // each sorted by time
+  std::vector<LidarRotation> open_;  // rotations of the window being filled
+  std::deque<Window> pending_;       // closed, waiting for the other sensors
+  std::deque<TimedScan> scans_;      // each sorted by time
   std::deque<TimedGnss> gnss_;
   std::deque<TimedAttitude> ahrs_;
   std::optional<Stamp> last_rotation_end_;
-  std::optional<Stamp> emitted_until_;    // end of the last emitted window
+  std::optional<Stamp> emitted_until_;  // end of the last emitted window
   std::uint64_t next_seq_ = 0;
   AssemblerCounters counters_;
 };

@@ -22,22 +22,21 @@
 //   which never entered).
 
 #include <atomic>
+#include <boost/lockfree/policies.hpp>
+#include <boost/lockfree/queue.hpp>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
 #include <vector>
-
-#include <boost/lockfree/policies.hpp>
-#include <mutex>
-#include <boost/lockfree/queue.hpp>
 
 #include "fieldguard/sync/threads.hpp"
 
@@ -57,9 +56,9 @@ enum class Outcome : std::uint8_t { Processed, Failed, Dropped, Discarded };
 }
 
 struct PoolParams {
-  std::size_t workers = 1;          // 1..64
-  std::size_t queue_capacity = 8;   // inputs waiting for a worker, 1..4096
-  std::size_t reorder_slack = 16;   // extra slots for results waiting for the consumer or for their turn
+  std::size_t workers = 1;         // 1..64
+  std::size_t queue_capacity = 8;  // inputs waiting for a worker, 1..4096
+  std::size_t reorder_slack = 16;  // extra slots for results waiting for the consumer or for their turn
   DropPolicy drop = DropPolicy::DropOldest;
   // Called, when set, each time a result becomes ready for poll(): on the worker that finished the job (or on the
   // producer's or owner's thread for a drop or a discard). It must not block: the daemon posts a wake-up to its

@@ -20,7 +20,7 @@ namespace fieldguard::sync {
 enum class SensorKind : std::uint8_t { Lidar3d = 0, Scan2d = 1, Gnss = 2, Ahrs = 3 };
 inline constexpr std::size_t kSensorCount = 4;
 inline constexpr std::array<SensorKind, kSensorCount> kAllSensors{SensorKind::Lidar3d, SensorKind::Scan2d,
-                                                                   SensorKind::Gnss, SensorKind::Ahrs};
+                                                                  SensorKind::Gnss, SensorKind::Ahrs};
 [[nodiscard]] constexpr std::string_view to_string(SensorKind k) {
   switch (k) {
     case SensorKind::Lidar3d: return "lidar3d";
@@ -36,17 +36,17 @@ inline constexpr std::array<SensorKind, kSensorCount> kAllSensors{SensorKind::Li
 
 // One 3D LiDAR rotation with its times mapped: point time_s is relative to `start`.
 struct LidarRotation {
-  std::uint64_t index = 0;   // the decoder's rotation index
-  Stamp start;               // mapped time of the first firing
-  Stamp end;                 // mapped time of the last firing
-  Stamp host;                // receive time of the first packet
+  std::uint64_t index = 0;  // the decoder's rotation index
+  Stamp start;              // mapped time of the first firing
+  Stamp end;                // mapped time of the last firing
+  Stamp host;               // receive time of the first packet
   bool partial = false;
   std::vector<LidarPoint> points;
 };
 
 struct TimedScan {
-  Stamp time;   // mapped sensor time
-  Stamp host;   // receive time
+  Stamp time;  // mapped sensor time
+  Stamp host;  // receive time
   scip::Scan scan;
 };
 
@@ -63,17 +63,17 @@ struct TimedAttitude {
 };
 
 struct SyncedFrame {
-  std::uint64_t seq = 0;        // 0, 1, 2, ... in emission order, no gaps
-  Stamp window_start;           // first firing of the first rotation
-  Stamp window_end;             // last firing of the last rotation
-  std::uint32_t rotations = 0;  // whole rotations in the window (1 at 5 Hz spin, 2 at 10 Hz, ...)
-  bool partial = false;         // a rotation was partial (stream start or end) or the window is short of a period
-  std::vector<LidarPoint> points;  // time_s relative to window_start
+  std::uint64_t seq = 0;            // 0, 1, 2, ... in emission order, no gaps
+  Stamp window_start;               // first firing of the first rotation
+  Stamp window_end;                 // last firing of the last rotation
+  std::uint32_t rotations = 0;      // whole rotations in the window (1 at 5 Hz spin, 2 at 10 Hz, ...)
+  bool partial = false;             // a rotation was partial (stream start or end) or the window is short of a period
+  std::vector<LidarPoint> points;   // time_s relative to window_start
   std::optional<TimedScan> scan2d;  // the scan nearest to the window's middle
   std::vector<TimedGnss> gnss;      // from the last epoch at or before window_start to the first at or after window_end
   std::vector<TimedAttitude> ahrs;  // likewise, every sample in between
-  std::uint8_t missing = 0;     // bit(SensorKind) for each required sensor whose data is incomplete
-  bool timed_out = false;       // emitted by the timeout, not because everything had arrived
+  std::uint8_t missing = 0;         // bit(SensorKind) for each required sensor whose data is incomplete
+  bool timed_out = false;           // emitted by the timeout, not because everything had arrived
 
   [[nodiscard]] bool is_missing(SensorKind k) const { return (missing & bit(k)) != 0; }
   [[nodiscard]] Stamp middle() const { return Stamp{window_start.ns + (window_end.ns - window_start.ns) / 2}; }

@@ -11,10 +11,10 @@ namespace fieldguard::sync {
 enum class SchedPolicy : unsigned char { Other, Fifo, RoundRobin };
 
 struct ThreadSettings {
-  std::string name;                           // at most 15 characters are kept (pthread_setname_np)
+  std::string name;  // at most 15 characters are kept (pthread_setname_np)
   SchedPolicy policy = SchedPolicy::Other;
-  int priority = 0;                           // 1..99 under Fifo / RoundRobin; ignored under Other
-  std::vector<int> cpus;                      // affinity; empty: any CPU
+  int priority = 0;       // 1..99 under Fifo / RoundRobin; ignored under Other
+  std::vector<int> cpus;  // affinity; empty: any CPU
 };
 
 // Applies `s` to the calling thread. Returns what was refused, "; "-separated ("SCHED_FIFO priority 50:

@@ -6,9 +6,9 @@
 #include <optional>
 #include <span>
 
-#include "fieldguard/writers/png_writer.hpp"
 #include "fieldguard/perception/obstacle.hpp"
 #include "fieldguard/perception/params.hpp"
+#include "fieldguard/writers/png_writer.hpp"
 
 namespace fieldguard::app {
 
@@ -20,8 +20,8 @@ struct BevView {
 };
 
 [[nodiscard]] Image render_bev(std::span<const perception::LabeledPoint> points, const perception::FrameResult& result,
-                               const perception::PipelineParams& params, const std::optional<perception::Box3>& stop_zone,
-                               const BevView& view = {});
+                               const perception::PipelineParams& params,
+                               const std::optional<perception::Box3>& stop_zone, const BevView& view = {});
 
 // Draws `obstacles`' oriented boxes and distances onto a picture render_bev made with `view` (render_bev draws the
 // frame's own): replay adds the hold's obstacles (obstacle_hold.hpp) this way, since the hold runs after the

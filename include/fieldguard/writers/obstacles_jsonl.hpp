@@ -1,13 +1,13 @@
 #pragma once
-// One JSON line per frame (a rotation, or a fused frame) for `replay --obstacles-out`. Numbers are printed with fixed decimals so the
-// same input gives byte-identical output. Written by hand, not with nlohmann/json like the other JSON lines:
-// nlohmann has no fixed-decimals output, and it took 1.4-1.5 times as long (benchmarks/json_writers_bench.cpp).
+// One JSON line per frame (a rotation, or a fused frame) for `replay --obstacles-out`. Numbers are printed with fixed
+// decimals so the same input gives byte-identical output. Written by hand, not with nlohmann/json like the other JSON
+// lines: nlohmann has no fixed-decimals output, and it took 1.4-1.5 times as long (benchmarks/json_writers_bench.cpp).
 
 #include <string>
 
-#include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/core/mounting.hpp"
+#include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/perception/obstacle.hpp"
 
 namespace fieldguard::app {
