@@ -14,9 +14,8 @@ struct CommandResult {
   std::string output;  // stdout and stderr, interleaved
 };
 
-// `args` is appended to the binary's path as shell words; quote them yourself where needed.
-inline CommandResult run_fieldguard(const std::string& args) {
-  const std::string cmd = std::string("'") + FIELDGUARD_BINARY + "' " + args + " 2>&1";
+// Runs `cmd` through the shell; the exit code (128 + the signal for a killed process) and what it wrote on stdout.
+inline CommandResult run_shell(const std::string& cmd) {
   CommandResult r;
   FILE* p = ::popen(cmd.c_str(), "r");
   if (p == nullptr) return r;
@@ -27,6 +26,14 @@ inline CommandResult run_fieldguard(const std::string& args) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return r;
 }
+
+#ifdef FIELDGUARD_BINARY
+// `args` is appended to the binary's path as shell words; quote them yourself where needed.
+inline CommandResult run_fieldguard(const std::string& args) {
+  const std::string cmd = std::string("'") + FIELDGUARD_BINARY + "' " + args + " 2>&1";
+  return run_shell(cmd);
+}
+#endif
 
 // The number after `label` in a summary line such as "  points            12345".
 inline long long summary_number(const std::string& output, const std::string& label) {

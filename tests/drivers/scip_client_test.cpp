@@ -26,6 +26,15 @@ ClientEvent one(Client& client, ReplyParser& parser, const std::string& bytes) {
   return events.empty() ? ClientEvent{} : events.front();
 }
 
+// Start, then the sensor's answers to SCIP2.0, VV, PP and II: the client asks for the laser next (BM).
+void identify(Client& c, ReplyParser& p) {
+  (void)c.start();
+  (void)one(c, p, test::simple_reply("SCIP2.0", "00"));
+  (void)one(c, p, test::utm_vv_reply());
+  (void)one(c, p, test::utm_pp_reply());
+  (void)one(c, p, test::utm_ii_reply());
+}
+
 // Runs the sequence up to Streaming; returns the command lines the client sent.
 std::vector<std::string> start_up(Client& c, ReplyParser& p, const std::string& md_echo) {
   std::vector<std::string> sent = {c.start()};
@@ -100,11 +109,7 @@ TEST(ScipClient, Scip11AndScip20OnlySensorsBothProceed) {
 TEST(ScipClient, LaserAlreadyOnIsFine) {
   Client c;
   ReplyParser p;
-  (void)c.start();
-  (void)one(c, p, test::simple_reply("SCIP2.0", "00"));
-  (void)one(c, p, test::utm_vv_reply());
-  (void)one(c, p, test::utm_pp_reply());
-  (void)one(c, p, test::utm_ii_reply());
+  identify(c, p);
   const auto e = one(c, p, test::simple_reply("BM", "02"));
   EXPECT_EQ(e.send, "MD0000108001000\n");
 }
@@ -113,11 +118,7 @@ TEST(ScipClient, RefusalsSayWhichCommandAndStatus) {
   {
     Client c;
     ReplyParser p;
-    (void)c.start();
-    (void)one(c, p, test::simple_reply("SCIP2.0", "00"));
-    (void)one(c, p, test::utm_vv_reply());
-    (void)one(c, p, test::utm_pp_reply());
-    (void)one(c, p, test::utm_ii_reply());
+    identify(c, p);
     const auto e = one(c, p, test::simple_reply("BM", "01"));
     ASSERT_TRUE(e.refused.has_value());
     EXPECT_EQ(e.refused->command, Command::BM);
@@ -193,11 +194,7 @@ TEST(ScipClient, SensorTroubleStaleRepliesAndBadScans) {
 TEST(ScipClient, ScansBeforeTheAcknowledgementStartTheStream) {
   Client c;
   ReplyParser p;
-  (void)c.start();
-  (void)one(c, p, test::simple_reply("SCIP2.0", "00"));
-  (void)one(c, p, test::utm_vv_reply());
-  (void)one(c, p, test::utm_pp_reply());
-  (void)one(c, p, test::utm_ii_reply());
+  identify(c, p);
   (void)one(c, p, test::simple_reply("BM", "00"));
   const auto e = one(c, p, test::scan_reply("MD0000108001000", "99", 1, test::range_pattern(kMaxSteps)));
   EXPECT_TRUE(e.scan.has_value());

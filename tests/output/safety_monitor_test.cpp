@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "output/test_obstacles.hpp"
+
 namespace fieldguard::output::safety {
 namespace {
 
@@ -16,19 +18,7 @@ constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 constexpr std::int64_t kMs = 1'000'000;
 constexpr std::int64_t kT0 = 1'000'000 * kMs;  // any host clock: a monotonic one in the daemon
 
-// An axis-aligned obstacle whose oriented footprint is the same box.
-perception::Obstacle box(float x0, float y0, float x1, float y1) {
-  perception::Obstacle o;
-  o.min = {x0, y0, -0.5F};
-  o.max = {x1, y1, 1.2F};
-  o.obb_center = {0.5F * (x0 + x1), 0.5F * (y0 + y1)};
-  o.obb_length_m = x1 - x0;
-  o.obb_width_m = y1 - y0;
-  o.obb_yaw_rad = 0.F;
-  o.distance_m = x0;
-  o.points = 40;
-  return o;
-}
+using test::box;
 
 // Drives a monitor at 5 Hz with every required sensor fresh unless told otherwise.
 class Drive {

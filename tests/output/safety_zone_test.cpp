@@ -5,22 +5,14 @@
 #include <limits>
 
 #include "fieldguard/output/safety_monitor.hpp"
+#include "output/test_obstacles.hpp"
 
 namespace fieldguard::output::safety {
 namespace {
 
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 
-// An axis-aligned obstacle whose oriented footprint is the same box.
-perception::Obstacle box(float x0, float y0, float x1, float y1) {
-  perception::Obstacle o;
-  o.min = {x0, y0, -0.5F};
-  o.max = {x1, y1, 1.2F};
-  o.obb_center = {0.5F * (x0 + x1), 0.5F * (y0 + y1)};
-  o.obb_length_m = x1 - x0;
-  o.obb_width_m = y1 - y0;
-  return o;
-}
+using test::box;
 
 TEST(SafetyZone, BoxOverlappingTheEdgeOverlapsThoughItsCentreIsOutside) {
   const Monitor m(Params{});

@@ -11,6 +11,8 @@
 #include <iterator>
 #include <string>
 
+#include "app/run_command.hpp"
+
 namespace fieldguard::tools_test {
 
 struct CommandResult {
@@ -25,14 +27,10 @@ inline CommandResult run(const std::string& binary, const std::string& args) {
   const std::filesystem::path err = std::filesystem::temp_directory_path() /
                                     ("fg_tools_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
   const std::string cmd = "'" + binary + "' " + args + " 2>'" + err.string() + "'";
+  const testing::CommandResult out = testing::run_shell(cmd);
   CommandResult r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
-  const int status = ::pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.exit_code = out.exit_code;
+  r.output = out.output;
   std::ifstream e(err);
   r.errors.assign(std::istreambuf_iterator<char>(e), std::istreambuf_iterator<char>());
   std::filesystem::remove(err);
