@@ -9,6 +9,15 @@
 namespace fieldguard::output {
 namespace {
 
+// The bytes of a candump line's data field: hex pairs from `from` to the end.
+std::vector<std::uint8_t> hex_bytes(const std::string& line, std::size_t from) {
+  std::vector<std::uint8_t> data;
+  for (std::size_t i = from; i + 1 < line.size(); i += 2) {
+    data.push_back(static_cast<std::uint8_t>(std::stoul(line.substr(i, 2), nullptr, 16)));
+  }
+  return data;
+}
+
 std::vector<std::uint8_t> bytes(std::initializer_list<int> v) {
   std::vector<std::uint8_t> out;
   for (const int b : v) out.push_back(static_cast<std::uint8_t>(b));
@@ -58,10 +67,7 @@ TEST(CanSpeed, RealTruckCaptureReadsZeroWhileParked) {
     const auto hash = line.find('#');
     ASSERT_NE(hash, std::string::npos);
     const auto id = static_cast<std::uint32_t>(std::stoul(line.substr(hash - 8, 8), nullptr, 16));
-    std::vector<std::uint8_t> data;
-    for (std::size_t i = hash + 1; i + 1 < line.size(); i += 2) {
-      data.push_back(static_cast<std::uint8_t>(std::stoul(line.substr(i, 2), nullptr, 16)));
-    }
+    const std::vector<std::uint8_t> data = hex_bytes(line, hash + 1);
     const auto r = decode_speed(id, data);
     if (r) {
       ++speeds;
@@ -91,10 +97,7 @@ TEST(CanSpeed, WholeRealTruckCaptureWhenPresent) {
     ASSERT_TRUE(hash != std::string::npos && space != std::string::npos) << line;
     if (hash - space - 1 != 8) continue;  // 11-bit ids are not J1939
     const auto id = static_cast<std::uint32_t>(std::stoul(line.substr(space + 1, 8), nullptr, 16));
-    std::vector<std::uint8_t> data;
-    for (std::size_t i = hash + 1; i + 1 < line.size(); i += 2) {
-      data.push_back(static_cast<std::uint8_t>(std::stoul(line.substr(i, 2), nullptr, 16)));
-    }
+    const std::vector<std::uint8_t> data = hex_bytes(line, hash + 1);
     const auto r = decode_speed(id, data);
     if (r) {
       ++speeds;
