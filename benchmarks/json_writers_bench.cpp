@@ -141,15 +141,6 @@ Json vec(const float* v, int n) {
   return a;
 }
 
-const char* levelling_name(geo::Levelling l) {
-  switch (l) {
-    case geo::Levelling::Full: return "full";
-    case geo::Levelling::AttitudeOnly: return "attitude_only";
-    case geo::Levelling::None: return "none";
-  }
-  return "?";
-}
-
 Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameResult& result,
                              const app::FusionInfo* fusion, const Mounting* lidar) {
   Json j = {{"frame", frame.index},
@@ -162,7 +153,7 @@ Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameRes
     for (const sync::SensorKind k : sync::kAllSensors) {
       if ((f.missing & sync::bit(k)) != 0) missing.push_back(sync::to_string(k));
     }
-    Json fj = {{"levelling", levelling_name(f.levelling)},
+    Json fj = {{"levelling", fieldguard::app::levelling_name(f.levelling)},
                {"rotations", f.rotations},
                {"scan_points", f.scan_points},
                {"missing", std::move(missing)},

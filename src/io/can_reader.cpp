@@ -30,6 +30,7 @@ Expected<int, std::string> CanReader::open_socket(std::string_view iface, const 
         (errno == EAFNOSUPPORT ? " (no SocketCAN in this kernel: load the can and can_raw modules)" : "")};
   }
   std::vector<can_filter> kf;
+  kf.reserve(filters.size());
   for (const CanFilter& f : filters) {
     kf.push_back(
         can_filter{(f.id & CAN_EFF_MASK) | CAN_EFF_FLAG, (f.mask & CAN_EFF_MASK) | CAN_EFF_FLAG | CAN_RTR_FLAG});

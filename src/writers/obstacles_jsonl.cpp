@@ -24,13 +24,10 @@ void vec(std::string& s, const float* v, int n) {
   s += ']';
 }
 
-const char* levelling_name(geo::Levelling l) {
-  switch (l) {
-    case geo::Levelling::Full: return "full";
-    case geo::Levelling::AttitudeOnly: return "attitude_only";
-    case geo::Levelling::None: return "none";
-  }
-  return "?";
+// ,"key":number with `decimals` (`key` with its leading comma and quotes, as the line spells it).
+void field(std::string& s, const char* key, double v, int decimals) {
+  s += key;
+  num(s, v, decimals);
 }
 
 void fusion_json(std::string& s, const FusionInfo& f) {
@@ -88,6 +85,15 @@ void plane_json(std::string& s, const perception::Obstacle& o, const perception:
 
 }  // namespace
 
+const char* levelling_name(geo::Levelling l) {
+  switch (l) {
+    case geo::Levelling::Full: return "full";
+    case geo::Levelling::AttitudeOnly: return "attitude_only";
+    case geo::Levelling::None: return "none";
+  }
+  return "?";
+}
+
 std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result,
                                 const FusionInfo* fusion, const Mounting* lidar) {
   std::string s = "{\"frame\":" + std::to_string(frame.index) + ",\"stamp\":";
@@ -109,18 +115,12 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
     vec(s, o.max.data(), 3);
     s += ",\"points\":" + std::to_string(o.points) + ",\"obb\":{\"center\":";
     vec(s, o.obb_center.data(), 2);
-    s += ",\"length\":";
-    num(s, static_cast<double>(o.obb_length_m), 3);
-    s += ",\"width\":";
-    num(s, static_cast<double>(o.obb_width_m), 3);
-    s += ",\"yaw\":";
-    num(s, static_cast<double>(o.obb_yaw_rad), 4);
-    s += "},\"distance\":";
-    num(s, static_cast<double>(o.distance_m), 3);
-    s += ",\"bearing\":";
-    num(s, static_cast<double>(o.bearing_deg), 2);
-    s += ",\"height\":";
-    num(s, static_cast<double>(o.height_above_ground_m), 3);
+    field(s, ",\"length\":", static_cast<double>(o.obb_length_m), 3);
+    field(s, ",\"width\":", static_cast<double>(o.obb_width_m), 3);
+    field(s, ",\"yaw\":", static_cast<double>(o.obb_yaw_rad), 4);
+    field(s, "},\"distance\":", static_cast<double>(o.distance_m), 3);
+    field(s, ",\"bearing\":", static_cast<double>(o.bearing_deg), 2);
+    field(s, ",\"height\":", static_cast<double>(o.height_above_ground_m), 3);
     s += ",\"class\":\"";
     s += perception::to_string(o.size_class);
     s += '"';

@@ -22,6 +22,9 @@ namespace fieldguard::app {
 // known "plane":[easting,northing,up]: the centre of its box's
 // footprint at the box's bottom, in plane coordinates (lidar: the 3D LiDAR's mounting, the detection
 // frame's origin in the level frame).
+// "full", "attitude_only" or "none", as the "fusion" object's "levelling" says it.
+[[nodiscard]] const char* levelling_name(geo::Levelling l);
+
 [[nodiscard]] std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result,
                                               const FusionInfo* fusion = nullptr, const Mounting* lidar = nullptr);
 
