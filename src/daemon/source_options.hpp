@@ -11,24 +11,22 @@
 namespace fieldguard::app {
 
 [[nodiscard]] inline io::SerialOptions serial_options(const SerialConfig& c) {
-  io::SerialOptions o;
-  o.device = c.device;
-  o.baud = c.baud;
-  o.data_bits = c.data_bits;
-  o.parity = c.parity;
-  o.stop_bits = c.stop_bits;
-  o.silence_timeout_s = c.silence_timeout_s;
-  o.reopen_interval_s = c.reopen_interval_s;
-  return o;
+  return {.device = c.device,
+          .baud = c.baud,
+          .data_bits = c.data_bits,
+          .parity = c.parity,
+          .stop_bits = c.stop_bits,
+          .silence_timeout_s = c.silence_timeout_s,
+          .reopen_interval_s = c.reopen_interval_s};
 }
 
 [[nodiscard]] inline io::ScipSourceOptions scip_source_options(const Scan2dConfig& c) {
   io::ScipSourceOptions o;
-  o.tcp.host = c.host;
-  o.tcp.port = c.port;
-  o.tcp.connect_timeout_s = c.connect_timeout_s;
-  o.tcp.silence_timeout_s = c.silence_timeout_s;
-  o.tcp.backoff_max_s = c.backoff_max_s;
+  o.tcp = {.host = c.host,
+           .port = c.port,
+           .connect_timeout_s = c.connect_timeout_s,
+           .silence_timeout_s = c.silence_timeout_s,
+           .backoff_max_s = c.backoff_max_s};
   o.client.scan.first_step = static_cast<std::uint16_t>(c.start_step);
   o.client.scan.last_step = static_cast<std::uint16_t>(c.end_step);
   o.client.intensity = c.intensity;

@@ -83,16 +83,14 @@ DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
   d.frame.host_stamp = sf.window_start;
   d.frame.partial = sf.partial;
   d.frame.points.swap(scratch_.points);
-  FusionInfo info;
-  info.levelling = scratch_.levelling;
-  info.reference = scratch_.reference;
-  info.attitude = scratch_.attitude;
-  info.stats = scratch_.stats;
-  info.missing = sf.missing;
-  info.timed_out = sf.timed_out;
-  info.rotations = sf.rotations;
-  info.scan_points = static_cast<std::uint32_t>(scratch_.stats.scan.points_out);
-  d.fusion = info;
+  d.fusion = FusionInfo{.levelling = scratch_.levelling,
+                        .reference = scratch_.reference,
+                        .attitude = scratch_.attitude,
+                        .stats = scratch_.stats,
+                        .missing = sf.missing,
+                        .timed_out = sf.timed_out,
+                        .rotations = sf.rotations,
+                        .scan_points = static_cast<std::uint32_t>(scratch_.stats.scan.points_out)};
   if (detect) d.result = pipeline_.process(d.frame.points);
   return d;
 }
