@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <string>
 #include <thread>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -34,6 +35,15 @@ fs::path temp_dir(const std::string& name) {
 }
 
 int open_tty(const fs::path& p) { return ::open(p.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC); }
+
+// The emulator's two link lines ("gnss PATH", "ahrs PATH", in that order) and both ttys opened: their fds, -1 for
+// one that could not be opened or was not announced as expected.
+std::pair<int, int> open_links(testing::ChildProcess& emu, const fs::path& dir) {
+  const bool gnss_said = emu.line() == "gnss " + (dir / "gnss").string();
+  const bool ahrs_said = emu.line() == "ahrs " + (dir / "ahrs").string();
+  EXPECT_TRUE(gnss_said && ahrs_said) << "the emulator did not announce its links";
+  return {gnss_said ? open_tty(dir / "gnss") : -1, ahrs_said ? open_tty(dir / "ahrs") : -1};
+}
 
 // Reads both devices for `seconds`, handing each read's bytes and its arrival time to the callbacks.
 template <typename OnGnss, typename OnAhrs>
@@ -65,12 +75,10 @@ TEST(NavEmulator, SendsGnssAndAhrsAtTheirRatesWithClocksThatRunForward) {
   const fs::path dir = temp_dir("rates");
   testing::ChildProcess emu({FIELDGUARD_NAV_EMULATOR, "--gnss-link", (dir / "gnss").string(), "--ahrs-link",
                              (dir / "ahrs").string(), "--lat", "48.2", "--lon", "11.5", "--heading", "90"});
-  ASSERT_EQ(emu.line(), "gnss " + (dir / "gnss").string());
-  ASSERT_EQ(emu.line(), "ahrs " + (dir / "ahrs").string());
-  const int gnss = open_tty(dir / "gnss");
-  const int ahrs = open_tty(dir / "ahrs");
-  ASSERT_GE(gnss, 0);
-  ASSERT_GE(ahrs, 0);
+  const auto links = open_links(emu, dir);
+  ASSERT_TRUE(links.first >= 0 && links.second >= 0) << "gnss fd " << links.first << ", ahrs fd " << links.second;
+  const int gnss = links.first;
+  const int ahrs = links.second;
   nmea::StreamParser nmea_parser;
   xsens::StreamParser xsens_parser;
   std::vector<nmea::Sentence> sentences;
@@ -184,12 +192,10 @@ TEST(NavEmulator, BytesCrossTheLineAtTheBaudRate) {
   // 4800 baud: 480 bytes a second; an epoch (GGA + RMC + HDT, about 190 bytes) takes about 0.4 s.
   testing::ChildProcess emu({FIELDGUARD_NAV_EMULATOR, "--gnss-link", (dir / "gnss").string(), "--ahrs-link",
                              (dir / "ahrs").string(), "--gnss-baud", "4800", "--gnss-rate", "1"});
-  ASSERT_EQ(emu.line(), "gnss " + (dir / "gnss").string());
-  ASSERT_EQ(emu.line(), "ahrs " + (dir / "ahrs").string());
-  const int gnss = open_tty(dir / "gnss");
-  const int ahrs = open_tty(dir / "ahrs");
-  ASSERT_GE(gnss, 0);
-  ASSERT_GE(ahrs, 0);
+  const auto links = open_links(emu, dir);
+  ASSERT_TRUE(links.first >= 0 && links.second >= 0) << "gnss fd " << links.first << ", ahrs fd " << links.second;
+  const int gnss = links.first;
+  const int ahrs = links.second;
   // The second epoch is timed whole: from its first bytes to its HDT, the sentences' bytes over 480 per second.
   nmea::StreamParser parser;
   std::vector<nmea::Sentence> sentences;
