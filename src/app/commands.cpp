@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "fieldguard/config/config.hpp"
@@ -230,16 +231,16 @@ Command add_inspect(CLI::App& top) {
               return usage_error(*cmd, files->empty() ? "no capture file given" : "more than one file: " + (*files)[1]);
             }
             opt->path = files->front();
-            const std::pair<const char*, const std::optional<std::string>&> ports[] = {
-                {"data-port", *data_port}, {"position-port", *position_port}};
-            for (const auto& [name, text] : ports) {
+            const std::tuple<const char*, const std::optional<std::string>&, std::optional<std::uint16_t>&> ports[] = {
+                {"data-port", *data_port, opt->data_port}, {"position-port", *position_port, opt->position_port}};
+            for (const auto& [name, text, out] : ports) {
               if (!text) continue;
               const auto port = whole_number(*text, 1, 65535);
               if (!port) {
                 return usage_error(*cmd,
                                    std::string("--") + name + " wants a UDP port number 1..65535, not '" + *text + "'");
               }
-              (name == ports[0].first ? opt->data_port : opt->position_port) = static_cast<std::uint16_t>(*port);
+              out = static_cast<std::uint16_t>(*port);
             }
             return inspect_capture(*opt);
           }};

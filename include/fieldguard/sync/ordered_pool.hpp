@@ -183,6 +183,7 @@ class OrderedPool {
   // What the system refused of PoolParams::worker, on the first worker that was refused anything; empty when
   // every worker that has started got its settings. Any thread.
   [[nodiscard]] std::string thread_refusal() const {
+    if (!has_refusal_.load(std::memory_order_acquire)) return {};  // the daemon asks every tick: no lock then
     const std::lock_guard lock(refusal_mutex_);
     return refusal_;
   }
@@ -250,6 +251,7 @@ class OrderedPool {
     if (std::string refused = apply_to_this_thread(params_.worker); !refused.empty()) {
       const std::lock_guard lock(refusal_mutex_);
       if (refusal_.empty()) refusal_ = std::move(refused);
+      has_refusal_.store(true, std::memory_order_release);
     }
     for (;;) {
       if (stopped_.load(std::memory_order_acquire) && !drain_) return;
@@ -342,6 +344,7 @@ class OrderedPool {
   std::vector<std::thread> workers_;
   mutable std::mutex refusal_mutex_;
   std::string refusal_;
+  std::atomic<bool> has_refusal_{false};  // refusal_ is set
   // Consumer only.
   std::map<std::uint64_t, Slot*> waiting_;
   std::atomic<std::uint64_t> next_out_{0};  // written by the consumer only; atomic for counters()
