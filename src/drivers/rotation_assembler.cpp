@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <utility>
 
@@ -48,7 +49,7 @@ void make_room(std::vector<LidarPoint>& v, std::size_t keep, std::size_t n) {
 }
 }  // namespace
 
-RotationAssembler::RotationAssembler(double cut_deg) {
+RotationAssembler::RotationAssembler(double cut_deg, RotationClose close) : close_(close) {
   double c = std::fmod(cut_deg, 360.0);
   if (c < 0.0) c += 360.0;
   const long cdeg = std::lround(c * 100.0);
@@ -105,6 +106,8 @@ void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stam
                                std::vector<LidarFrame>& done) {
   std::size_t end = count_ + std::min(count, current_.points.size() - std::min(count_, current_.points.size()));
   std::size_t i = count_;
+  std::size_t packet_first = count_;  // where this packet's points begin in the frame under way
+  const int first_rel = i < end ? relative_cdeg(current_.points[i].azimuth_cdeg, cut_cdeg_) : -1;
   bool counted = false;  // this packet already counted in the current frame
   double packet_to_frame_s = static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
   // Members the loops read and write, in locals (stores to the points must not make the compiler reload them).
@@ -131,11 +134,13 @@ void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stam
             make_room(next, 0, tail);
             std::copy(pts + i, pts + end, next.begin());
             count_ = i;
+            current_.last_host_stamp = packet_host_time;
             emit(done, !current_started_at_cut_, std::move(next));
             current_started_at_cut_ = true;
             have = false;
             i = 0;
             end = tail;
+            packet_first = 0;
             continue;
           }
           current_started_at_cut_ = true;
@@ -176,6 +181,40 @@ void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stam
   count_ = end;
   prev_rel_cdeg_ = prev;
   have_current_ = have;
+  end_packet(packet_first, first_rel, packet_host_time, done);
+}
+
+void RotationAssembler::end_packet(std::size_t first, int first_rel, Stamp packet_host_time,
+                                   std::vector<LidarFrame>& done) {
+  if (first >= count_) return;  // no point: not a packet of the frame (as it is not counted)
+  current_.last_host_stamp = packet_host_time;
+  // The step of the packet's first firing from the packet before's (mod one turn).
+  if (packet_first_rel_ >= 0) {
+    const int step = (first_rel - packet_first_rel_ + kFullTurnCdeg) % kFullTurnCdeg;
+    step_jitter_ = packet_step_ >= 0 ? std::abs(step - packet_step_) : -1;
+    packet_step_ = step;
+  }
+  packet_first_rel_ = first_rel;
+  if (close_ != RotationClose::LastFiring || !have_current_ || step_jitter_ < 0) return;
+  // A steady step (a lost packet or a jump shows as a change of more than an eighth) of at most a tenth of a turn.
+  if (packet_step_ <= 0 || packet_step_ > kFullTurnCdeg / 10 || 8 * step_jitter_ > packet_step_) return;
+  // The frame must be in its second half (its last firing before the cut, no step back across it pending).
+  if (prev_rel_cdeg_ < kWrapCdeg) return;
+  // The lowest azimuth of this packet, one step on, with twice the step's jitter as margin: at or past the cut, the
+  // next packet holds no firing of this rotation. (Only the packets near the cut are looked at point by point.)
+  if (first_rel + packet_step_ < kFullTurnCdeg) return;
+  int lowest = kFullTurnCdeg;
+  for (std::size_t i = first; i < count_; ++i) {
+    lowest = std::min(lowest, relative_cdeg(current_.points[i].azimuth_cdeg, cut_cdeg_));
+  }
+  if (lowest < kWrapCdeg || lowest + packet_step_ - 2 * step_jitter_ < kFullTurnCdeg) return;
+  last_frame_points_ = count_;  // sizes the next buffer
+  emit(done, !current_started_at_cut_, fresh_buffer());
+  // The cut is made: the next frame starts at it. Should a firing of the next packet still lie a little before the
+  // cut after all (the prediction missed), it is a step back just after a cut: it joins the next frame, as a per-laser
+  // azimuth correction does, and cuts nothing.
+  prev_rel_cdeg_ = 0;
+  current_started_at_cut_ = true;
 }
 
 std::optional<double> RotationAssembler::in_frame_offset_s(AzimuthRange azimuths, Stamp packet_sensor_time) const {
@@ -194,17 +233,20 @@ std::optional<double> RotationAssembler::in_frame_offset_s(AzimuthRange azimuths
   return static_cast<double>(packet_sensor_time.ns - current_.sensor_stamp.ns) * 1e-9;
 }
 
-void RotationAssembler::commit_in_frame(std::size_t count) {
+void RotationAssembler::commit_in_frame(std::size_t count, Stamp packet_host_time, std::vector<LidarFrame>& done) {
   const std::size_t size = current_.points.size();
   const std::size_t end = count_ + std::min(count, size - std::min(count_, size));
   // No point: nothing happens, as in commit() (the packet is not counted).
   if (end == count_) return;
   ++current_.packets;
   prev_rel_cdeg_ = relative_cdeg(current_.points[end - 1].azimuth_cdeg, cut_cdeg_);
+  const std::size_t first = count_;
   count_ = end;
+  end_packet(first, relative_cdeg(current_.points[first].azimuth_cdeg, cut_cdeg_), packet_host_time, done);
 }
 
-bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sensor_time, AzimuthRange azimuths) {
+bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time,
+                                            std::vector<LidarFrame>& done, AzimuthRange azimuths) {
   const std::size_t size = current_.points.size();
   const std::size_t end = count_ + std::min(count, size - std::min(count_, size));
   if (end == count_) return false;
@@ -214,13 +256,13 @@ bool RotationAssembler::commit_within_frame(std::size_t count, Stamp packet_sens
   for (std::size_t i = count_; i < end; ++i) {
     pts[i].time_s = static_cast<float>(*packet_to_frame_s + static_cast<double>(pts[i].time_s));
   }
-  commit_in_frame(count);
+  commit_in_frame(count, packet_host_time, done);
   return true;
 }
 
 void RotationAssembler::commit(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time,
                                std::vector<LidarFrame>& done, AzimuthRange azimuths) {
-  if (!commit_within_frame(count, packet_sensor_time, azimuths))
+  if (!commit_within_frame(count, packet_sensor_time, packet_host_time, done, azimuths))
     commit(count, packet_sensor_time, packet_host_time, done);
 }
 
@@ -231,6 +273,9 @@ void RotationAssembler::finish(std::vector<LidarFrame>& done) {
   have_current_ = false;
   current_started_at_cut_ = false;
   prev_rel_cdeg_ = -1;
+  packet_first_rel_ = -1;
+  packet_step_ = -1;
+  step_jitter_ = -1;
 }
 
 void RotationAssembler::recycle(LidarFrame&& frame) {

@@ -55,7 +55,7 @@ void Stream::decode_one(ByteSpan payload, const PacketHeader& header, Stamp host
     // Nearly every packet: inside the frame under way, so the decoder writes the frame-relative times itself and
     // the assembler need not go over the points again.
     count = decoder_->decode_accepted(payload, header, azimuths, fixed, offset_s);
-    assembler_.commit_in_frame(count);
+    assembler_.commit_in_frame(count, host_time, done);
   } else {
     count = decoder_->decode_accepted(payload, header, azimuths, fixed, std::nullopt);
     assembler_.commit(count, sensor, host_time, done, azimuths.bounds());

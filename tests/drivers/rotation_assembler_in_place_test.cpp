@@ -90,9 +90,9 @@ TEST(RotationAssemblerInPlace, RealCapturesGiveTheReferenceFrames) {
         const std::string what =
             std::string(c.file) + " cut " + std::to_string(cut) + (corrections ? " with corrections" : "");
         reference::RotationAssembler ref(cut);
-        RotationAssembler pushed(cut);
-        RotationAssembler in_place(cut);
-        RotationAssembler recycling(cut);
+        RotationAssembler pushed(cut, RotationClose::NextRotation);
+        RotationAssembler in_place(cut, RotationClose::NextRotation);
+        RotationAssembler recycling(cut, RotationClose::NextRotation);
         std::vector<LidarFrame> want;
         std::vector<LidarFrame> got_push;
         std::vector<LidarFrame> got_in_place;
@@ -139,7 +139,7 @@ TEST(RotationAssemblerInPlace, RandomStreamsGiveTheReferenceFrames) {
   for (int run = 0; run < 40; ++run) {
     const double cut = run % 4 == 0 ? 0.0 : uniform(0, 35999) / 100.0;
     reference::RotationAssembler ref(cut);
-    RotationAssembler fast(cut);
+    RotationAssembler fast(cut, RotationClose::NextRotation);
     std::vector<LidarFrame> want;
     std::vector<LidarFrame> got;
     int az = uniform(0, 35999);
@@ -185,7 +185,7 @@ TEST(RotationAssemblerInPlace, AzimuthBoundsGiveTheReferenceFrames) {
   for (int run = 0; run < 40; ++run) {
     const double cut = run % 4 == 0 ? 0.0 : uniform(0, 35999) / 100.0;
     reference::RotationAssembler ref(cut);
-    RotationAssembler fast(cut);
+    RotationAssembler fast(cut, RotationClose::NextRotation);
     std::vector<LidarFrame> want;
     std::vector<LidarFrame> got;
     int az = uniform(0, 35999);
@@ -241,7 +241,7 @@ TEST(RotationAssemblerInPlace, FrameRelativeTimesFromTheDecoderGiveTheReferenceF
   for (int run = 0; run < 40; ++run) {
     const double cut = run % 4 == 0 ? 0.0 : uniform(0, 35999) / 100.0;
     reference::RotationAssembler ref(cut);
-    RotationAssembler fast(cut);
+    RotationAssembler fast(cut, RotationClose::NextRotation);
     std::vector<LidarFrame> want;
     std::vector<LidarFrame> got;
     EXPECT_FALSE(fast.in_frame_offset_s(AzimuthRange{100, 200}, Stamp{0}).has_value()) << "no frame under way";
@@ -271,7 +271,7 @@ TEST(RotationAssemblerInPlace, FrameRelativeTimesFromTheDecoderGiveTheReferenceF
         for (std::size_t i = 0; i < pts.size(); ++i) {
           room[i].time_s = static_cast<float>(*offset + static_cast<double>(pts[i].time_s));
         }
-        fast.commit_in_frame(pts.size());
+        fast.commit_in_frame(pts.size(), Stamp{t + 700}, got);
         ++(pts.empty() ? empty_in_frame : in_frame);
       } else {
         fast.commit(pts.size(), Stamp{t}, Stamp{t + 700}, got, bounds);
@@ -293,7 +293,7 @@ TEST(RotationAssemblerInPlace, FrameRelativeTimesFromTheDecoderGiveTheReferenceF
 TEST(RotationAssemblerInPlace, UninformativeAzimuthBoundsAreSafe) {
   for (const AzimuthRange bounds : {AzimuthRange{}, AzimuthRange{500, 100}, AzimuthRange{0, 36000}}) {
     reference::RotationAssembler ref(0.0);
-    RotationAssembler fast(0.0);
+    RotationAssembler fast(0.0, RotationClose::NextRotation);
     std::vector<LidarFrame> want;
     std::vector<LidarFrame> got;
     for (int k = 0; k < 250; ++k) {

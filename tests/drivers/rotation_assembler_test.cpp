@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "drivers/velodyne_test_support.hpp"
@@ -214,6 +215,140 @@ TEST(RotationAssembler, RealHdl32eCapture) {
   EXPECT_LT(ahead[1].points.front().azimuth_cdeg, 100);
   EXPECT_GT(ahead[0].points.back().azimuth_cdeg, 35800);
   EXPECT_EQ(ahead[0].packets + ahead[1].packets, 92U);  // the packet with the cut counts in both
+}
+
+// A stream whose packets meet the cut on a packet boundary (an emulator's, or a sensor phase-locked to the cut): the
+// rotation comes out with the packet carrying its last firing, not a packet later, with the points it has when it
+// waits for the next rotation; and a stream that ends on a whole turn ends on a full rotation.
+TEST(RotationAssembler, ARotationEndingBetweenPacketsIsEmittedWithItsLastPacket) {
+  // 25 cdeg a firing, 24 firings a packet: 600 cdeg a packet, 60 packets a turn, the first at the cut.
+  const Synthetic s{.start_cdeg = 0, .step_cdeg = 25, .per_packet = 24};
+  const std::size_t turns = 4;
+  const std::size_t n = turns * 36000 / 25;
+  auto assemble = [&](RotationClose close, std::vector<std::size_t>& emitted_after) {
+    RotationAssembler a(0.0, close);
+    std::vector<LidarFrame> done;
+    for (std::size_t first = 0; first < n; first += s.per_packet) {
+      std::vector<LidarPoint> pts;
+      for (std::size_t i = first; i < first + s.per_packet; ++i) {
+        LidarPoint p;
+        p.azimuth_cdeg = s.azimuth(i);
+        p.time_s = static_cast<float>(static_cast<double>(static_cast<std::int64_t>(i - first) * kPointNs) * 1e-9);
+        p.intensity = static_cast<float>(i % 256);
+        pts.push_back(p);
+      }
+      const std::size_t before = done.size();
+      a.push(pts, s.sensor(first), Stamp{static_cast<std::int64_t>(first / s.per_packet)}, done);
+      for (std::size_t k = before; k < done.size(); ++k) emitted_after.push_back(first / s.per_packet);
+    }
+    a.finish(done);
+    return done;
+  };
+  std::vector<std::size_t> early_at;
+  std::vector<std::size_t> late_at;
+  const auto early = assemble(RotationClose::LastFiring, early_at);
+  const auto late = assemble(RotationClose::NextRotation, late_at);
+  ASSERT_EQ(early.size(), turns);
+  ASSERT_EQ(late.size(), turns);
+  ASSERT_EQ(early_at.size(), turns);  // all of them while the stream runs, none left for finish()
+  ASSERT_EQ(late_at.size(), turns - 1);
+  const std::size_t packets_per_turn = 36000 / (25 * 24);
+  for (std::size_t k = 0; k < turns; ++k) {
+    SCOPED_TRACE(k);
+    // Packets 0..59 make turn 0, and its last one emits it; waiting, it came with packet 60.
+    EXPECT_EQ(early_at[k], (k + 1) * packets_per_turn - 1);
+    if (k + 1 < turns) {
+      EXPECT_EQ(late_at[k], (k + 1) * packets_per_turn);
+    }
+    EXPECT_EQ(early[k].last_host_stamp.ns, static_cast<std::int64_t>((k + 1) * packets_per_turn - 1));
+    EXPECT_EQ(early[k].host_stamp, late[k].host_stamp);
+    EXPECT_EQ(early[k].sensor_stamp, late[k].sensor_stamp);
+    EXPECT_EQ(early[k].packets, packets_per_turn);
+    // The first is partial as the stream's first (it did not start by passing the cut); the others are whole turns.
+    EXPECT_EQ(early[k].partial, k == 0);
+    ASSERT_EQ(early[k].points.size(), late[k].points.size());
+    for (std::size_t j = 0; j < early[k].points.size(); ++j) {
+      ASSERT_EQ(early[k].points[j].azimuth_cdeg, late[k].points[j].azimuth_cdeg);
+      ASSERT_EQ(early[k].points[j].time_s, late[k].points[j].time_s);
+    }
+  }
+  EXPECT_TRUE(late.back().partial) << "waiting for a next rotation that never comes, finish() emits it partial";
+}
+
+// The step is predicted; where the next packet after all starts a little before the cut (the sensor's spin wavered),
+// its firings join the next rotation, like per-laser corrections right after a cut: no frame of a few points.
+TEST(RotationAssembler, AMissedPredictionMovesAFewFiringsToTheNextRotation) {
+  RotationAssembler a(0.0);
+  std::vector<LidarFrame> done;
+  auto packet = [&](int first_cdeg) {
+    std::vector<LidarPoint> pts(24);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      pts[i].azimuth_cdeg = static_cast<std::uint16_t>((first_cdeg + 25 * static_cast<int>(i)) % 36000);
+    }
+    a.push(pts, Stamp{1}, Stamp{1}, done);
+  };
+  for (int first = 0; first < 36000; first += 600) packet(first);  // a whole turn, the last packet at 354 deg
+  ASSERT_EQ(done.size(), 1U) << "emitted with its last packet";
+  packet(35990);  // 0.1 deg short of the predicted start
+  packet(590);
+  packet(1190);
+  EXPECT_EQ(done.size(), 1U) << "no cut for the firings just before the cut";
+  a.finish(done);
+  ASSERT_EQ(done.size(), 2U);
+  EXPECT_EQ(done[1].points.size(), 72U);
+  EXPECT_EQ(done[1].points.front().azimuth_cdeg, 35990);
+}
+
+// A lost packet, or a step that changes, gives no prediction: the rotation waits for the next one's first packet.
+TEST(RotationAssembler, AnUnsteadyStepWaitsForTheNextRotation) {
+  RotationAssembler a(0.0);
+  std::vector<LidarFrame> done;
+  auto packet = [&](int first_cdeg) {
+    std::vector<LidarPoint> pts(24);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      pts[i].azimuth_cdeg = static_cast<std::uint16_t>((first_cdeg + 25 * static_cast<int>(i)) % 36000);
+    }
+    a.push(pts, Stamp{1}, Stamp{1}, done);
+  };
+  for (int first = 0; first < 34800; first += 600) packet(first);
+  packet(35400);  // the one at 348 deg lost: a step of 1200 after steps of 600
+  EXPECT_TRUE(done.empty());
+  packet(0);
+  EXPECT_EQ(done.size(), 1U);
+}
+
+// Real captures, whose cut falls where the packets put it: the same frames either way.
+TEST(RotationAssembler, RealCapturesGiveTheSameRotationsEitherWay) {
+  using namespace velodyne;
+  for (const auto& [file, model] : {std::pair{"hdl32e_monterey_600.pcap", Model::HDL32E},
+                                    std::pair{"vlp16_veloview_300.pcap", Model::VLP16}}) {
+    SCOPED_TRACE(file);
+    const auto packets = test::read_data_packets(test::test_data(file));
+    DecoderOptions o;
+    o.model = model;
+    const Decoder d(default_calibration(model), o);
+    auto assemble = [&](RotationClose close) {
+      RotationAssembler a(0.0, close);
+      std::vector<LidarFrame> done;
+      std::vector<LidarPoint> pts;
+      for (const auto& r : packets) {
+        pts.clear();
+        const auto h = d.decode(r.payload, pts);
+        if (h) a.push(pts, sensor_time_from_hour_offset(h->timestamp_us, r.host), r.host, done);
+      }
+      a.finish(done);
+      return done;
+    };
+    const auto early = assemble(RotationClose::LastFiring);
+    const auto late = assemble(RotationClose::NextRotation);
+    ASSERT_GE(early.size(), 2U);
+    ASSERT_EQ(early.size(), late.size());
+    for (std::size_t k = 0; k < early.size(); ++k) {
+      EXPECT_EQ(early[k].points.size(), late[k].points.size());
+      EXPECT_EQ(early[k].partial, late[k].partial);
+      EXPECT_EQ(early[k].last_host_stamp, late[k].last_host_stamp);
+    }
+  }
 }
 
 }  // namespace

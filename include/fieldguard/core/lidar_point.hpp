@@ -34,6 +34,7 @@ struct LidarFrame {
   std::uint64_t index = 0;    // 0-based rotation index in the stream
   Stamp sensor_stamp;         // sensor time of the first firing in the frame
   Stamp host_stamp;           // host / pcap time of the frame's first packet
+  Stamp last_host_stamp;      // host / pcap time of the packet carrying its last point (kernel receive time live)
   bool partial = false;       // the first or last rotation of a stream, not a full 360 degrees
   std::uint32_t packets = 0;  // data packets that contributed
   std::vector<LidarPoint> points;

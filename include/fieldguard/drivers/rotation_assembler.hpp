@@ -1,6 +1,11 @@
 #pragma once
 // Cuts a stream of decoded points into rotations: a frame ends where the azimuth passes the cut angle.
 // One producer: not thread-safe. Push-style: frames come out as they complete.
+//
+// A rotation is complete with the packet that carries its last firing. Where the cut angle falls inside a packet,
+// that packet shows it; where it falls between two packets (an emulator, or a sensor phase-locked to the cut),
+// the azimuth steps of the packets before tell it: when the next packet's firings, one steady step on, all lie
+// past the cut, the rotation is emitted at once instead of a packet period later (RotationClose::LastFiring).
 
 #include <cstddef>
 #include <cstdint>
@@ -20,9 +25,15 @@ struct AzimuthRange {
   std::uint16_t max_cdeg = 0xFFFF;  // the default holds every azimuth: no information
 };
 
+// When a rotation whose cut falls between two packets is emitted: with the packet carrying its last firing (as
+// predicted from the steady azimuth step of the packets), or only when the next rotation's first packet arrives.
+// The frames and their points are the same either way; the last rotation of a stream that ends on a whole turn is
+// full with LastFiring and partial (emitted by finish()) with NextRotation.
+enum class RotationClose : std::uint8_t { LastFiring, NextRotation };
+
 class RotationAssembler {
  public:
-  explicit RotationAssembler(double cut_deg = 0.0);
+  explicit RotationAssembler(double cut_deg = 0.0, RotationClose close = RotationClose::LastFiring);
 
   // Points of one packet (time_s relative to packet_sensor_time), in firing order. Completed frames are
   // appended to `done`. Point times in an emitted frame are relative to the frame's sensor_stamp.
@@ -53,8 +64,8 @@ class RotationAssembler {
   [[nodiscard]] std::optional<double> in_frame_offset_s(AzimuthRange azimuths, Stamp packet_sensor_time) const;
   // Commits the first `count` points of append_room(), written with frame-relative times after in_frame_offset_s()
   // gave an offset (and nothing else changed the assembler in between). Gives exactly what commit() with bounds
-  // gives for the same points with packet-relative times.
-  void commit_in_frame(std::size_t count);
+  // gives for the same points with packet-relative times (including a frame the packet completes, into `done`).
+  void commit_in_frame(std::size_t count, Stamp packet_host_time, std::vector<LidarFrame>& done);
 
   // End of stream: emits what is pending as a partial frame (if it holds any point).
   void finish(std::vector<LidarFrame>& done);
@@ -70,9 +81,18 @@ class RotationAssembler {
   [[nodiscard]] std::vector<LidarPoint> fresh_buffer();
   // commit() of a packet that, by its azimuth bounds, neither ends the frame nor starts one; false (nothing done)
   // where the bounds do not show that.
-  [[nodiscard]] bool commit_within_frame(std::size_t count, Stamp packet_sensor_time, AzimuthRange azimuths);
+  [[nodiscard]] bool commit_within_frame(std::size_t count, Stamp packet_sensor_time, Stamp packet_host_time,
+                                         std::vector<LidarFrame>& done, AzimuthRange azimuths);
+  // Bookkeeping of a packet whose points [first, count_) of the frame under way were just committed (first_rel: its
+  // first firing's azimuth relative to the cut): its azimuth step, the frame's last host time, and the emission of
+  // a frame the packet completes (RotationClose::LastFiring).
+  void end_packet(std::size_t first, int first_rel, Stamp packet_host_time, std::vector<LidarFrame>& done);
 
   std::uint16_t cut_cdeg_;
+  RotationClose close_;
+  int packet_first_rel_ = -1;  // the last packet's first firing, relative to the cut (cdeg)
+  int packet_step_ = -1;       // cdeg between the first firings of the last two packets
+  int step_jitter_ = -1;       // |change| of that step from the packet before; -1 unknown
   // The frame under construction. Its points vector is kept larger than the frame (room for the next packets,
   // constructed once per buffer): the frame's points are the first count_; emit() trims it.
   LidarFrame current_;
