@@ -6,12 +6,13 @@ namespace fieldguard::app {
 
 void read_sync(YamlReader& r, const YAML::Node& n, SyncConfig& c) {
   const std::string path = "sync";
-  if (!r.section(n, path, {"rate_hz", "timeout_s", "max_scan_offset_s", "max_pending"})) return;
+  if (!r.section(n, path, {"rate_hz", "timeout_s", "max_scan_offset_s", "max_pending", "pose"})) return;
   // The limits are sync::AssemblerParams' own: a value the loader accepts never makes the synchronizer throw.
   r.number(n, path, "rate_hz", c.rate_hz, 0.5, 50.0, "Hz");
   r.number(n, path, "timeout_s", c.timeout_s, 0.01, 10.0, "s");
   r.number(n, path, "max_scan_offset_s", c.max_scan_offset_s, 0.001, 1.0, "s");
   r.integer(n, path, "max_pending", c.max_pending, 1, 64);
+  if (auto p = r.choice(n, path, "pose", {"extrapolate", "wait"})) c.extrapolate_pose = *p == 0;
 }
 
 void read_geo(YamlReader& r, const YAML::Node& n, GeoConfig& c) {

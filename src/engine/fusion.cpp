@@ -46,6 +46,12 @@ sync::SyncParams sync_params(const Config& cfg, const FusionInputs& in) {
   p.assembler.require_scan2d = in.scan2d;
   p.assembler.require_gnss = in.gnss;
   p.assembler.require_ahrs = in.ahrs;
+  if (cfg.sync.extrapolate_pose) {
+    // No further than the compensator's pose track extrapolates (compensation_params()).
+    const geo::TrackParams track = compensation_params(cfg).track;
+    p.assembler.gnss_lead_s = std::min(track.max_position_extrapolation_s, p.assembler.max_bracket_gap_s);
+    p.assembler.ahrs_lead_s = std::min(track.max_attitude_extrapolation_s, p.assembler.max_bracket_gap_s);
+  }
   return p;
 }
 
@@ -141,6 +147,7 @@ void SensorFusion::rotations_to(Stamp host, std::vector<FrameJob>& out) {
       FrameJob& j = out.emplace_back();
       j.rotation = std::move(f);
       j.complete = host;
+      j.last_packet = j.rotation.last_host_stamp;
       ++counts_.frames;
     }
   }
@@ -158,6 +165,7 @@ void SensorFusion::jobs_from_frames(Stamp host, std::vector<FrameJob>& out) {
     FrameJob& j = out.emplace_back();
     j.synced = std::move(f);
     j.complete = host;
+    j.last_packet = j.synced->last_packet_host;
     ++counts_.frames;
   }
   frames_.clear();

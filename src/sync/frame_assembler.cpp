@@ -37,10 +37,23 @@ void trim(std::deque<T>& d, std::int64_t history, bool keep_one_before) {
   }
 }
 
-// Samples from the last at or before `start` to the first at or after `end`; `complete` when both exist within
-// `max_gap` of the window.
+// The newest sample is at most `lead` before `end`, and an earlier epoch within `max_gap` of it gives the motion to
+// continue from it.
 template <typename T>
-bool bracket(const std::deque<T>& d, Stamp start, Stamp end, std::int64_t max_gap, std::vector<T>& out) {
+bool extrapolable(const std::deque<T>& d, Stamp end, std::int64_t lead, std::int64_t max_gap) {
+  if (d.size() < 2 || d.back().time.ns < end.ns - lead) return false;
+  for (auto it = d.rbegin() + 1; it != d.rend(); ++it) {
+    if (it->time != d.back().time) return d.back().time.ns - it->time.ns <= max_gap;
+  }
+  return false;
+}
+
+// Samples from the last at or before `start` to the first at or after `end`; `complete` when both exist within
+// `max_gap` of the window, or when the first exists and, with no sample at or after `end`, the newest one is at most
+// `lead` before it (the pose is extrapolated from there).
+template <typename T>
+bool bracket(const std::deque<T>& d, Stamp start, Stamp end, std::int64_t max_gap, std::int64_t lead,
+             std::vector<T>& out) {
   out.clear();
   if (d.empty()) return false;
   // First index with time > start, then step back to the last at or before it.
@@ -58,6 +71,14 @@ bool bracket(const std::deque<T>& d, Stamp start, Stamp end, std::int64_t max_ga
     upper_ok = true;
     const Stamp t = last->time;
     while (last != d.end() && last->time == t) ++last;
+  } else if (last == d.end() && lead > 0 && extrapolable(d, end, lead, max_gap)) {
+    upper_ok = true;
+    // Extrapolated from the newest samples: the epoch before the first goes in too, so that two epochs at least
+    // give the motion to continue (one alone would only be held).
+    if (lower_ok && first != d.begin() && first->time.ns - std::prev(first)->time.ns <= max_gap) {
+      --first;
+      while (first != d.begin() && std::prev(first)->time == first->time) --first;
+    }
   }
   if (first < last) out.assign(first, last);
   return lower_ok && upper_ok;
@@ -71,6 +92,10 @@ std::vector<std::string> AssemblerParams::validate() const {
   if (!(timeout_s > 0.0 && timeout_s <= 10.0)) p.emplace_back("sync.timeout_s must be in (0, 10]");
   if (!(max_scan_offset_s > 0.0)) p.emplace_back("sync.max_scan_offset_s must be positive");
   if (!(max_bracket_gap_s > 0.0)) p.emplace_back("sync.max_bracket_gap_s must be positive");
+  if (!(gnss_lead_s >= 0.0 && gnss_lead_s <= max_bracket_gap_s))
+    p.emplace_back("sync.gnss_lead_s must be in [0, max_bracket_gap_s]");
+  if (!(ahrs_lead_s >= 0.0 && ahrs_lead_s <= max_bracket_gap_s))
+    p.emplace_back("sync.ahrs_lead_s must be in [0, max_bracket_gap_s]");
   if (!(history_s >= timeout_s)) p.emplace_back("sync.history_s must be at least timeout_s");
   if (max_pending < 1) p.emplace_back("sync.max_pending must be at least 1");
   return p;
@@ -151,8 +176,13 @@ std::uint8_t FrameAssembler::not_ready(const Window& w) const {
   std::uint8_t nr = 0;
   const Stamp mid{w.start.ns + (w.end.ns - w.start.ns) / 2};
   if (params_.require_scan2d && (scans_.empty() || scans_.back().time < mid)) nr |= bit(SensorKind::Scan2d);
-  if (params_.require_gnss && (gnss_.empty() || gnss_.back().time < w.end)) nr |= bit(SensorKind::Gnss);
-  if (params_.require_ahrs && (ahrs_.empty() || ahrs_.back().time < w.end)) nr |= bit(SensorKind::Ahrs);
+  // A sample at or after the end, or one close enough before it to extrapolate from (see bracket()).
+  const std::int64_t gap = to_ns(params_.max_bracket_gap_s);
+  const auto ready = [&](const auto& d, double lead_s) {
+    return !d.empty() && (d.back().time >= w.end || (lead_s > 0.0 && extrapolable(d, w.end, to_ns(lead_s), gap)));
+  };
+  if (params_.require_gnss && !ready(gnss_, params_.gnss_lead_s)) nr |= bit(SensorKind::Gnss);
+  if (params_.require_ahrs && !ready(ahrs_, params_.ahrs_lead_s)) nr |= bit(SensorKind::Ahrs);
   return nr;
 }
 
@@ -192,6 +222,7 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   f.partial = w.partial;
   f.timed_out = timed_out;
   f.rotations = static_cast<std::uint32_t>(w.rotations.size());
+  for (const LidarRotation& r : w.rotations) f.last_packet_host = std::max(f.last_packet_host, r.last_host);
   // The first rotation starts the window: its points are taken over as they are (no copy at 5 Hz spin); the
   // others are appended with their times shifted onto the window's start.
   std::size_t n = 0;
@@ -218,8 +249,10 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   }
   if (params_.require_scan2d && !f.scan2d) f.missing |= bit(SensorKind::Scan2d);
   const std::int64_t gap = to_ns(params_.max_bracket_gap_s);
-  if (!bracket(gnss_, w.start, w.end, gap, f.gnss) && params_.require_gnss) f.missing |= bit(SensorKind::Gnss);
-  if (!bracket(ahrs_, w.start, w.end, gap, f.ahrs) && params_.require_ahrs) f.missing |= bit(SensorKind::Ahrs);
+  if (!bracket(gnss_, w.start, w.end, gap, to_ns(params_.gnss_lead_s), f.gnss) && params_.require_gnss)
+    f.missing |= bit(SensorKind::Gnss);
+  if (!bracket(ahrs_, w.start, w.end, gap, to_ns(params_.ahrs_lead_s), f.ahrs) && params_.require_ahrs)
+    f.missing |= bit(SensorKind::Ahrs);
 
   ++counters_.frames;
   if (timed_out) ++counters_.timed_out;

@@ -100,6 +100,7 @@ void Synchronizer::push_lidar(LidarFrame&& rotation) {
   for (const LidarPoint& p : rotation.points) last = std::max(last, p.time_s);
   r.end = Stamp{r.start.ns + static_cast<std::int64_t>(std::llround(static_cast<double>(last) * 1e9))};
   r.host = rotation.host_stamp;
+  r.last_host = rotation.last_host_stamp;
   r.partial = rotation.partial;
   r.points = std::move(rotation.points);
   const std::uint64_t late = assembler_.counters().late_rotations;

@@ -388,5 +388,106 @@ TEST(AssemblerParams, RejectsNonsense) {
   EXPECT_THROW(FrameAssembler{p}, std::invalid_argument);
 }
 
+// Frames of `run`, each with the receive time of the event after which it left.
+struct Left {
+  SyncedFrame frame;
+  std::int64_t at = 0;
+};
+std::vector<Left> run_timed(FrameAssembler& fa, const Scenario& sc, const std::vector<Event>& ev) {
+  std::vector<Left> left;
+  std::vector<SyncedFrame> out;
+  for (const Event& e : ev) {
+    switch (e.kind) {
+      case 0: fa.add_rotation(rotation(e.index, e.t, sc.rotation_ns)); break;
+      case 1: fa.add_scan(scan_at(e.t)); break;
+      case 2: fa.add_gnss(gnss_at(e.t)); break;
+      default: fa.add_attitude(ahrs_at(e.t)); break;
+    }
+    fa.poll(Stamp{e.rx}, out);
+    for (SyncedFrame& f : out) left.push_back({std::move(f), e.rx});
+    out.clear();
+  }
+  return left;
+}
+
+// With a lead, a frame need not wait for the GNSS fix after its end (10 Hz fixes, 40 ms late here): it leaves with
+// the rotation that closes it, complete, with the two newest epochs to extrapolate from; the same points as when it
+// waits.
+TEST(FrameAssembler, WithALeadAFrameLeavesWhenItsLastRotationIsWhole) {
+  Scenario sc;
+  AssemblerParams lead;
+  lead.gnss_lead_s = 0.25;
+  lead.ahrs_lead_s = 0.02;
+  FrameAssembler early(lead);
+  FrameAssembler waiting;
+  const auto ev = events(sc);
+  const auto a = run_timed(early, sc, ev);
+  const auto b = run_timed(waiting, sc, ev);
+  ASSERT_EQ(a.size(), 15U);
+  ASSERT_EQ(b.size(), 15U);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    SCOPED_TRACE(k);
+    const SyncedFrame& f = a[k].frame;
+    // The closing rotation arrives 1 ms after its end: that is when the frame leaves.
+    EXPECT_EQ(a[k].at, f.window_end.ns + sc.rotation_ns / 100 + kMs);
+    EXPECT_GT(b[k].at, a[k].at + 20 * kMs) << "waiting, it left with a later fix";
+    EXPECT_EQ(f.missing, 0);
+    EXPECT_FALSE(f.timed_out);
+    ASSERT_EQ(f.points.size(), b[k].frame.points.size());
+    EXPECT_EQ(f.window_end, b[k].frame.window_end);
+    // From the epoch at or before the start, and the one before it (the first frame has none), to the newest: all
+    // before the end.
+    ASSERT_GE(f.gnss.size(), 2U);
+    EXPECT_LE(f.gnss.front().time.ns, f.window_start.ns - (k == 0 ? 0 : 100 * kMs));
+    EXPECT_LT(f.gnss.back().time, f.window_end);
+    EXPECT_GE(f.gnss.back().time.ns, f.window_end.ns - 250 * kMs);
+    EXPECT_LE(f.ahrs.front().time, f.window_start);
+    EXPECT_GE(f.ahrs.back().time.ns, f.window_end.ns - 20 * kMs);
+  }
+  EXPECT_EQ(early.counters().complete, 15U);
+}
+
+// The lead is no licence to go without: a single fix gives no motion to extrapolate, and a newest fix older than the
+// lead is waited for; the frame then leaves when the fix comes, or at its timeout, lacking GNSS.
+TEST(FrameAssembler, ALeadNeedsTwoRecentEpochs) {
+  AssemblerParams lead;
+  lead.gnss_lead_s = 0.25;
+  lead.require_scan2d = false;
+  lead.require_ahrs = false;
+  {
+    FrameAssembler fa(lead);
+    fa.add_gnss(gnss_at(kT0 - 50 * kMs));
+    fa.add_rotation(rotation(0, kT0, 200 * kMs));
+    std::vector<SyncedFrame> out;
+    fa.poll(Stamp{kT0 + 210 * kMs}, out);
+    EXPECT_TRUE(out.empty()) << "one epoch";
+    fa.add_gnss(gnss_at(kT0 + 50 * kMs));
+    fa.poll(Stamp{kT0 + 211 * kMs}, out);
+    ASSERT_EQ(out.size(), 1U) << "two epochs, the newest 148 ms before the end";
+    EXPECT_EQ(out[0].missing, 0);
+    EXPECT_EQ(out[0].gnss.size(), 2U);
+  }
+  {
+    FrameAssembler fa(lead);
+    fa.add_gnss(gnss_at(kT0 - 350 * kMs));
+    fa.add_gnss(gnss_at(kT0 - 250 * kMs));
+    fa.add_rotation(rotation(0, kT0, 200 * kMs));
+    std::vector<SyncedFrame> out;
+    fa.poll(Stamp{kT0 + 210 * kMs}, out);
+    EXPECT_TRUE(out.empty()) << "the newest fix 448 ms before the end";
+    fa.poll(Stamp{kT0 + 700 * kMs}, out);
+    ASSERT_EQ(out.size(), 1U);
+    EXPECT_TRUE(out[0].timed_out);
+    EXPECT_TRUE(out[0].is_missing(SensorKind::Gnss));
+  }
+}
+
+TEST(AssemblerParams, ALeadIsWithinTheBracketGap) {
+  AssemblerParams p;
+  p.gnss_lead_s = -0.1;
+  p.ahrs_lead_s = 2.0;  // more than max_bracket_gap_s 1.0
+  EXPECT_EQ(p.validate().size(), 2U);
+}
+
 }  // namespace
 }  // namespace fieldguard::sync

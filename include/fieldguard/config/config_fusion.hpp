@@ -19,6 +19,11 @@ struct SyncConfig {
   double timeout_s = 0.5;          // a frame still waiting for a sensor this long after its window goes out
   double max_scan_offset_s = 0.1;  // the 2D scan nearest the window's middle, if at most this far
   int max_pending = 8;             // windows waiting for late sensors; beyond it the oldest goes out
+  // A frame goes out when its last rotation is whole, its pose extrapolated from the newest GNSS fix and AHRS sample
+  // (within geo's extrapolation limits of the window's end: half max_position_gap_s, 0.4 max_attitude_gap_s);
+  // false: it waits for the fix and the sample after its end and interpolates (a fix period plus the receiver's
+  // latency later).
+  bool extrapolate_pose = true;
 };
 
 struct GeoConfig {

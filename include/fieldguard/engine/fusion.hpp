@@ -60,7 +60,8 @@ struct FusionInputs {
 struct FrameJob {
   LidarFrame rotation;                      // rotations mode
   std::optional<sync::SyncedFrame> synced;  // fused mode
-  Stamp complete;  // host time at which the frame was whole: its last data in hand (or its timeout)
+  Stamp complete;     // host time at which the frame was whole: its last data in hand (or its timeout)
+  Stamp last_packet;  // receive time of its last 3D LiDAR packet (the kernel's, live): where its latency starts
 };
 
 // What the outputs need of the compensation.

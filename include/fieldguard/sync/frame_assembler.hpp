@@ -7,7 +7,10 @@
 // each frame is one rotation. A gap in the rotations (a lost one) closes the window early, marked partial.
 //
 // A closed window waits until every required sensor can no longer change its contents: a 2D scan at or after
-// the window's middle (the nearest is then known), a GNSS fix and an AHRS sample at or after its end. Any sensor
+// the window's middle (the nearest is then known), a GNSS fix and an AHRS sample at or after its end. With a lead
+// (gnss_lead_s, ahrs_lead_s) it need not wait for that fix or sample: a newest one at most the lead before the end
+// makes it ready, and the pose is extrapolated over the rest (geo::PoseTrack), so a frame goes out when its last
+// rotation is whole instead of a fix period plus the receiver's latency later. Any sensor
 // may run ahead of or behind the others. Samples are kept sorted, so one sensor's own samples may also arrive out
 // of order, as long as none arrives after a newer one of the same sensor has already completed a window that
 // needed it (serial and TCP streams keep their order; that case is not compensated).
@@ -31,6 +34,8 @@ struct AssemblerParams {
   double timeout_s = 0.5;          // wait for late sensors this long after a window's end
   double max_scan_offset_s = 0.1;  // a 2D scan farther than this from the window's middle is not "its" scan
   double max_bracket_gap_s = 1.0;  // GNSS/AHRS bracket samples farther than this outside the window do not count
+  double gnss_lead_s = 0.0;        // ready without the fix after the end when the newest is at most this before it
+  double ahrs_lead_s = 0.0;        // likewise for the AHRS sample (0: wait for the bracket)
   double history_s = 3.0;          // samples kept behind the newest window and behind each sensor's newest sample
   std::size_t max_pending = 8;     // closed windows waiting; beyond it the oldest is emitted as timed out
   bool require_scan2d = true;

@@ -40,6 +40,7 @@ struct LidarRotation {
   Stamp start;              // mapped time of the first firing
   Stamp end;                // mapped time of the last firing
   Stamp host;               // receive time of the first packet
+  Stamp last_host;          // receive time of the packet carrying its last firing
   bool partial = false;
   std::vector<LidarPoint> points;
 };
@@ -66,6 +67,7 @@ struct SyncedFrame {
   std::uint64_t seq = 0;            // 0, 1, 2, ... in emission order, no gaps
   Stamp window_start;               // first firing of the first rotation
   Stamp window_end;                 // last firing of the last rotation
+  Stamp last_packet_host;           // receive time of the window's last 3D LiDAR packet: a decision's latency starts here
   std::uint32_t rotations = 0;      // whole rotations in the window (1 at 5 Hz spin, 2 at 10 Hz, ...)
   bool partial = false;             // a rotation was partial (stream start or end) or the window is short of a period
   std::vector<LidarPoint> points;   // time_s relative to window_start
