@@ -368,6 +368,42 @@ TEST(OrderedPool, OnResultWakesAConsumerThatPollsOnlyWhenTold) {
   pool.stop(Drain::Yes);
 }
 
+// ProcessInto writes each result over its slot's earlier one, and a steady producer, one frame at a time, keeps using
+// the same few slots (the free list is last in, first out): after the first frames no buffer is new, on either side.
+TEST(OrderedPool, ProcessIntoReusesTheBuffersOfAFewSlots) {
+  PoolParams p;
+  p.workers = 2;
+  p.queue_capacity = 8;
+  OrderedPool<Item, std::vector<std::uint64_t>> pool(p, [](Item& it, std::vector<std::uint64_t>& out) {
+    out.assign(64, digest(it));  // the same size every time: the earlier result's room suffices
+  });
+  std::set<const void*> outputs;
+  std::set<const void*> inputs;
+  std::uint64_t checked = 0;
+  const auto sink = [&](const auto& r) {
+    ASSERT_EQ(r.outcome, Outcome::Processed);
+    ASSERT_NE(r.output, nullptr);
+    EXPECT_EQ(r.output->front(), digest(*r.input)) << "the result is this ticket's, not an earlier one's";
+    if (r.ticket >= 10) outputs.insert(r.output->data());
+    ++checked;
+  };
+  Item in;
+  for (std::uint64_t seq = 0; seq < 200; ++seq) {
+    in.seq = seq;
+    in.payload.resize(16);  // a handed-back input keeps its room
+    for (std::uint32_t i = 0; i < 16; ++i) in.payload[i] = static_cast<std::uint32_t>(seq * 31 + i);
+    if (seq >= 10) inputs.insert(in.payload.data());
+    ASSERT_TRUE(pool.submit(in));
+    while (pool.outstanding() > 0) pool.poll_wait(sink);
+  }
+  pool.stop(Drain::Yes);
+  pool.poll(sink);
+  EXPECT_EQ(checked, 200U);
+  // One frame at a time: the slot just released is the next one taken.
+  EXPECT_LE(outputs.size(), 2U) << "results written into new buffers";
+  EXPECT_LE(inputs.size(), 2U) << "inputs handed back from other slots than the last";
+}
+
 TEST(OrderedPool, RejectsBadParameters) {
   const auto f = [](Item& it) { return it.seq; };
   PoolParams p;

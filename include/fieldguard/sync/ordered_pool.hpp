@@ -7,9 +7,12 @@
 // (may be the producer's); stop() from the owner once the producer has stopped submitting (idempotent); the
 // destructor stops and joins. counters() and outstanding() may be read from any thread.
 //
-// - The producer never blocks: every job lives in a slot taken from a preallocated lock-free free list, and all
-//   three queues are fixed-size boost::lockfree::queue. Nothing is allocated after construction: an input is
-//   swapped into its slot, and the caller gets the slot's earlier input back to refill.
+// - The producer never blocks: every job lives in a slot taken from a preallocated lock-free free list (a fixed-size
+//   boost::lockfree::stack), the two queues are fixed-size boost::lockfree::queue, and results wait for their turn
+//   in a ring of the slots.
+//   The pool allocates nothing after construction: an input is swapped into its slot, and the caller gets the
+//   slot's earlier input back to refill; a ProcessInto writes its result over the slot's earlier one, whose
+//   buffers it may reuse.
 // - A full input queue drops, by policy, the oldest queued input or the new one. A dropped input still takes its
 //   place in the order: the consumer is told (Outcome::Dropped) when its turn comes, so a gap is never silent.
 //   When every slot is in use (the consumer has fallen far behind) the new input is refused outright and counted
@@ -24,14 +27,13 @@
 #include <atomic>
 #include <boost/lockfree/policies.hpp>
 #include <boost/lockfree/queue.hpp>
+#include <boost/lockfree/stack.hpp>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <functional>
-#include <map>
 #include <memory>
 #include <mutex>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -83,6 +85,9 @@ template <typename In, typename Out>
 class OrderedPool {
  public:
   using Process = std::function<Out(In&)>;
+  // The form that allocates nothing once warm: writes the result into `out`, the slot's output of an earlier ticket
+  // (default-constructed the first time), whose buffers it may reuse; a throw leaves the slot without a result.
+  using ProcessInto = std::function<void(In&, Out&)>;
   // One result per ticket, in ticket order. `output` is set for Processed only; `error` for Failed.
   struct Result {
     std::uint64_t ticket = 0;
@@ -94,12 +99,15 @@ class OrderedPool {
   using Sink = std::function<void(const Result&)>;
 
   OrderedPool(const PoolParams& params, Process process)
+      : OrderedPool(params, ProcessInto([p = std::move(process)](In& in, Out& out) { out = p(in); })) {}
+  OrderedPool(const PoolParams& params, ProcessInto process)
       : params_(check(params)),
         process_(std::move(process)),
         slots_(params_.queue_capacity + params_.workers + params_.reorder_slack + 1),
         free_(slots_.size()),
         input_(params_.queue_capacity),
-        done_(slots_.size()) {
+        done_(slots_.size()),
+        waiting_(slots_.size(), nullptr) {
     for (Slot& s : slots_) release(&s);
     workers_.reserve(params_.workers);
     for (std::size_t i = 0; i < params_.workers; ++i) workers_.emplace_back([this] { work(); });
@@ -119,13 +127,16 @@ class OrderedPool {
 
   // Consumer. Hands every result whose turn has come to `sink`, in ticket order; returns how many.
   std::size_t poll(const Sink& sink) {
+    // Every ticket not yet delivered holds a slot, so no two of them share a place in the ring.
     Slot* s = nullptr;
-    while (done_.pop(s)) waiting_.emplace(s->ticket, s);
+    while (done_.pop(s)) waiting_[s->ticket % waiting_.size()] = s;
     std::size_t n = 0;
     std::uint64_t next = next_out_.load(std::memory_order_relaxed);
-    for (auto it = waiting_.begin(); it != waiting_.end() && it->first == next; it = waiting_.begin()) {
-      Slot* slot = it->second;
-      waiting_.erase(it);
+    for (;;) {
+      Slot*& at = waiting_[next % waiting_.size()];
+      if (at == nullptr || at->ticket != next) break;
+      Slot* slot = at;
+      at = nullptr;
       next_out_.store(++next, std::memory_order_release);
       deliver(*slot, sink);
       ++n;
@@ -193,7 +204,8 @@ class OrderedPool {
     std::uint64_t ticket = 0;
     Outcome outcome = Outcome::Processed;
     In input{};
-    std::optional<Out> output;
+    Out output{};  // kept from ticket to ticket, buffers and all (ProcessInto)
+    bool has_output = false;
     std::string error;
   };
 
@@ -223,7 +235,7 @@ class OrderedPool {
     }
     using std::swap;
     swap(s->input, in);
-    s->output.reset();
+    s->has_output = false;
     s->error.clear();
     s->outcome = Outcome::Processed;
     s->ticket = next_ticket_.load(std::memory_order_relaxed);
@@ -270,7 +282,8 @@ class OrderedPool {
 
   void run(Slot& s) {
     try {
-      s.output.emplace(process_(s.input));
+      process_(s.input, s.output);
+      s.has_output = true;
       finish(s, Outcome::Processed);
     } catch (const std::exception& e) {
       s.error = e.what();
@@ -302,7 +315,7 @@ class OrderedPool {
     r.ticket = s.ticket;
     r.outcome = s.outcome;
     r.input = &s.input;
-    if (s.outcome == Outcome::Processed && s.output) r.output = &*s.output;
+    if (s.outcome == Outcome::Processed && s.has_output) r.output = &s.output;
     if (s.outcome == Outcome::Failed) r.error = &s.error;
     try {
       sink(r);
@@ -326,11 +339,14 @@ class OrderedPool {
   }
 
   using PtrQueue = boost::lockfree::queue<Slot*, boost::lockfree::fixed_sized<true>>;
+  // Free slots last in, first out: the few slots a steady stream needs are reused again and again, so their buffers
+  // (inputs handed back to the producer, outputs written over) are warm after a few frames, not after every slot.
+  using PtrStack = boost::lockfree::stack<Slot*, boost::lockfree::fixed_sized<true>>;
 
   PoolParams params_;
-  Process process_;
+  ProcessInto process_;
   std::vector<Slot> slots_;
-  PtrQueue free_;
+  PtrStack free_;
   PtrQueue input_;
   PtrQueue done_;
   std::atomic<std::size_t> queued_{0};
@@ -346,7 +362,7 @@ class OrderedPool {
   std::string refusal_;
   std::atomic<bool> has_refusal_{false};  // refusal_ is set
   // Consumer only.
-  std::map<std::uint64_t, Slot*> waiting_;
+  std::vector<Slot*> waiting_;  // finished, by ticket modulo its size (the slots'), until their turn
   std::atomic<std::uint64_t> next_out_{0};  // written by the consumer only; atomic for counters()
 };
 
