@@ -77,17 +77,36 @@ FrameDetector::FrameDetector(const Config& cfg) : pipeline_(cfg.perception), com
 
 DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
   DetectedFrame d;
+  process(job, d, detect);
+  return d;
+}
+
+void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
   if (!job.synced) {
-    d.frame = std::move(job.rotation);
-    if (detect) d.result = pipeline_.process(d.frame.points);
-    return d;
+    // The rotation trades places with the earlier result's frame, whose buffer the job takes back to the producer.
+    std::swap(d.frame, job.rotation);
+    d.fusion.reset();
+    if (!detect) {
+      d.result = perception::FrameResult{};
+      return;
+    }
+    try {
+      pipeline_.process(d.frame.points, d.result);
+    } catch (...) {
+      std::swap(d.frame, job.rotation);  // the job is still the rotation that failed, for the report
+      throw;
+    }
+    return;
   }
   const sync::SyncedFrame& sf = *job.synced;
   compensator_.compensate(sf, scratch_);
   d.frame.index = sf.seq;
   d.frame.sensor_stamp = sf.window_start;
   d.frame.host_stamp = sf.window_start;
+  d.frame.last_host_stamp = sf.last_packet_host;
   d.frame.partial = sf.partial;
+  d.frame.packets = 0;
+  // The compensated points to the result, and its earlier points' buffer to the compensator for the next frame.
   d.frame.points.swap(scratch_.points);
   d.fusion = FusionInfo{.levelling = scratch_.levelling,
                         .reference = scratch_.reference,
@@ -97,8 +116,11 @@ DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
                         .timed_out = sf.timed_out,
                         .rotations = sf.rotations,
                         .scan_points = static_cast<std::uint32_t>(scratch_.stats.scan.points_out)};
-  if (detect) d.result = pipeline_.process(d.frame.points);
-  return d;
+  if (detect) {
+    pipeline_.process(d.frame.points, d.result);
+  } else {
+    d.result = perception::FrameResult{};
+  }
 }
 
 DetectorSet::DetectorSet(const Config& cfg, std::size_t n) {
@@ -158,6 +180,17 @@ void SensorFusion::rotations_to(Stamp host, std::vector<FrameJob>& out) {
 void SensorFusion::frames_to(Stamp host, std::vector<FrameJob>& out) {
   sync_->poll(host, frames_);
   jobs_from_frames(host, out);
+  // The buffers of rotations copied into a frame, back to the stream for later rotations.
+  LidarFrame spare;
+  while (sync_->take_spare_points(spare.points)) stream_->recycle(std::move(spare));
+}
+
+void SensorFusion::recycle(FrameJob& job) {
+  if (job.rotation.points.capacity() > 0) stream_->recycle(std::move(job.rotation));
+  if (job.synced && sync_) {
+    sync_->recycle(std::move(*job.synced));
+    job.synced.reset();
+  }
 }
 
 void SensorFusion::jobs_from_frames(Stamp host, std::vector<FrameJob>& out) {

@@ -63,16 +63,8 @@ int quality_rank(int q) {
   }
 }
 
-// One GGA fix that passed the checks, projected.
-struct Fix {
-  Stamp t;
-  PlaneCoord plane;
-};
-
-struct AttSample {
-  Stamp t;
-  Eigen::Quaterniond q;
-};
+using Fix = CompensationWork::Fix;
+using AttSample = CompensationWork::AttSample;
 
 // The sample's Euler angles turned to the ENU convention AttitudeModel was built for; nullopt when the
 // coordinate system is not one we can interpret.
@@ -177,8 +169,9 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
   CompensationStats& st = out.stats;
 
   // GNSS first: the first usable fix gives the meridian convergence the attitudes need.
-  std::vector<Fix> fixes;
-  fixes.reserve(frame.gnss.size());
+  CompensationWork& work = out.work;
+  std::vector<Fix>& fixes = work.fixes;
+  fixes.clear();
   for (const sync::TimedGnss& g : frame.gnss) {
     const auto* gga = std::get_if<nmea::Gga>(&g.sentence);
     if (gga == nullptr) continue;
@@ -198,9 +191,15 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
   }
   const double convergence_deg = fixes.empty() ? 0.0 : fixes.front().plane.convergence_deg;
 
-  PoseTrack track(params_.track);
-  std::vector<AttSample> atts;
-  atts.reserve(frame.ahrs.size());
+  if (!work.track || work.track_owner != this) {
+    work.track.emplace(params_.track);
+    work.track_owner = this;
+  } else {
+    work.track->clear();
+  }
+  PoseTrack& track = *work.track;
+  std::vector<AttSample>& atts = work.atts;
+  atts.clear();
   for (const sync::TimedAttitude& a : frame.ahrs) {
     const auto& e = a.data.euler_deg;
     const auto enu = e ? enu_euler(*e, a.data.euler_frame) : std::nullopt;
@@ -254,7 +253,8 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
   }
 
   // The 2D scan in the 3D LiDAR's frame, its times relative to window_start like the 3D points'.
-  std::vector<SourcedPoint> lifted;
+  std::vector<SourcedPoint>& lifted = work.lifted;
+  lifted.clear();
   if (frame.scan2d) {
     const scip::Scan& scan = frame.scan2d->scan;
     const double step_s = params_.scan_turn_period_s / params_.scan_geometry.steps_per_turn;
@@ -265,7 +265,8 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
 
   const Eigen::Vector3f t_lidar(static_cast<float>(params_.lidar.x_m), static_cast<float>(params_.lidar.y_m),
                                 static_cast<float>(params_.lidar.z_m));
-  std::vector<SourcedPoint> level;
+  std::vector<SourcedPoint>& level = work.level;
+  level.clear();
   std::span<const LidarPoint> points3d(frame.points);
   std::span<const SourcedPoint> points2d(lifted);
   const Deskewer* used = nullptr;

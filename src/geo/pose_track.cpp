@@ -13,8 +13,8 @@ std::int64_t to_ns(double s) { return std::llround(s * 1e9); }
 bool valid_limit(double s) { return std::isfinite(s) && s >= 0.0 && s <= 60.0; }
 
 // Index of the first sample later than t (samples sorted by t_ns, strictly increasing).
-template <typename Deque>
-std::size_t upper(const Deque& d, std::int64_t t) {
+template <typename Samples>
+std::size_t upper(const Samples& d, std::int64_t t) {
   const auto it = std::upper_bound(d.begin(), d.end(), t, [](std::int64_t v, const auto& s) { return v < s.t_ns; });
   return static_cast<std::size_t>(it - d.begin());
 }
@@ -74,7 +74,7 @@ bool PoseTrack::add_attitude(Stamp t, const Eigen::Quaterniond& vehicle_in_plane
     return false;
   }
   att_.push_back({t.ns, q.normalized()});
-  if (att_.size() > params_.max_samples) att_.pop_front();
+  if (att_.size() > params_.max_samples) att_.erase(att_.begin());
   return true;
 }
 
@@ -89,7 +89,7 @@ bool PoseTrack::add_position(Stamp t, const Eigen::Vector3d& reference_in_plane)
     return false;
   }
   pos_.push_back({t.ns, p});
-  if (pos_.size() > params_.max_samples) pos_.pop_front();
+  if (pos_.size() > params_.max_samples) pos_.erase(pos_.begin());
   return true;
 }
 
@@ -152,8 +152,21 @@ Expected<Pose, TrackError> PoseTrack::pose_at(Stamp t) const {
 }
 
 void PoseTrack::drop_before(Stamp t) {
-  while (att_.size() > 1 && att_[1].t_ns <= t.ns) att_.pop_front();
-  while (pos_.size() > 1 && pos_[1].t_ns <= t.ns) pos_.pop_front();
+  // The first sample to keep: the last at or before t (the one after it is the first later than t).
+  const auto keep_from = [&](const auto& v) {
+    std::size_t i = 0;
+    while (i + 1 < v.size() && v[i + 1].t_ns <= t.ns) ++i;
+    return static_cast<std::ptrdiff_t>(i);
+  };
+  att_.erase(att_.begin(), att_.begin() + keep_from(att_));
+  pos_.erase(pos_.begin(), pos_.begin() + keep_from(pos_));
+}
+
+void PoseTrack::clear() {
+  att_.clear();
+  pos_.clear();
+  rejected_order_ = 0;
+  rejected_finite_ = 0;
 }
 
 }  // namespace fieldguard::geo

@@ -146,8 +146,18 @@ float Pipeline::ground_z(float x, float y) const {
 }
 
 FrameResult Pipeline::process(std::span<const LidarPoint> points) {
-  Impl& m = *impl_;
   FrameResult result;
+  process(points, result);
+  return result;
+}
+
+void Pipeline::process(std::span<const LidarPoint> points, FrameResult& result) {
+  Impl& m = *impl_;
+  // Over the last frame's result: its vectors keep their room.
+  result.obstacles.clear();
+  result.fragments.clear();
+  result.counts = StageCounts{};
+  result.times = StageTimes{};
   const auto start = std::chrono::steady_clock::now();
   auto lap = start;
   // ROI and body box, then the voxel grid. (One pass doing both measured no faster: the cropped cloud stays
@@ -351,7 +361,6 @@ FrameResult Pipeline::process(std::span<const LidarPoint> points) {
   sort_obstacles(result.obstacles);
   result.times.near_us = lap_us(lap);
   result.times.total_us = std::chrono::duration<float, std::micro>(lap - start).count();
-  return result;
 }
 
 }  // namespace fieldguard::perception

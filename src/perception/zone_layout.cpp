@@ -136,24 +136,36 @@ void ZoneGround::bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const {
     f32x4 lo;  // r0, inv_ring_width, max_ring, sector_scale
     f32x4 hi;  // max_sector, first_bin and sectors (their bits), unused
   };
-  std::vector<Rows> rows;
-  for (const Zone& z : zones_) {
+  // On the stack for up to kFixedZones zones (a frame allocates nothing), on the heap beyond.
+  constexpr std::size_t kFixedZones = 16;
+  std::array<Rows, kFixedZones> fixed_rows{};
+  std::vector<Rows> more_rows;
+  if (zones_.size() > kFixedZones) more_rows.resize(zones_.size());
+  Rows* const rows = zones_.size() <= kFixedZones ? fixed_rows.data() : more_rows.data();
+  for (std::size_t k = 0; k < zones_.size(); ++k) {
+    const Zone& z = zones_[k];
     const i32x4 ints = {0, static_cast<std::int32_t>(z.first_bin), static_cast<std::int32_t>(z.sectors), 0};
     Rows r{{z.r0, z.inv_ring_width, z.max_ring, z.sector_scale}, {}};
     std::memcpy(&r.hi, &ints, sizeof ints);
     r.hi[0] = z.max_sector;
-    rows.push_back(r);
+    rows[k] = r;
   }
-  std::vector<f32x4> ends;  // ends[k]: where zone k + 1 begins
-  for (std::size_t k = 1; k < zones_.size(); ++k) ends.push_back(simd::splat(zones_[k - 1].r1));
-  // Up to kFixedEnds ends (five zones) also in a fixed array, the rest NaN, which no range passes (every comparison
-  // with NaN is false): a loop of known length, unrolled, its ends kept in registers.
+  const Rows* const row = rows;
+  // Up to kFixedEnds ends (five zones) in a fixed array, the rest NaN, which no range passes (every comparison with
+  // NaN is false): a loop of known length, unrolled, its ends kept in registers. More ends: all of them in a vector.
   constexpr std::size_t kFixedEnds = 4;
+  const std::size_t n_ends = zones_.empty() ? 0 : zones_.size() - 1;  // end k: where zone k + 1 begins
   std::array<f32x4, kFixedEnds> fixed_ends{};
   fixed_ends.fill(simd::splat(std::numeric_limits<float>::quiet_NaN()));
-  std::copy(ends.begin(), ends.begin() + static_cast<std::ptrdiff_t>(std::min(ends.size(), kFixedEnds)),
-            fixed_ends.begin());
-  const Rows* const row = rows.data();
+  std::vector<f32x4> ends;
+  for (std::size_t k = 0; k < n_ends; ++k) {
+    const f32x4 end = simd::splat(zones_[k].r1);
+    if (n_ends <= kFixedEnds) {
+      fixed_ends[k] = end;
+    } else {
+      ends.push_back(end);
+    }
+  }
   const f32x4 zero = simd::splat(0.F), pi = simd::splat(std::numbers::pi_v<float>);
   std::size_t p = 0;
   const auto run = [&](const auto& zone_ends) {
@@ -186,7 +198,7 @@ void ZoneGround::bins_of(const Cloud& in, Buffer<std::uint32_t>& out) const {
       std::memcpy(out.data() + p, &b, sizeof b);
     }
   };
-  if (ends.size() <= kFixedEnds) {
+  if (n_ends <= kFixedEnds) {
     run(fixed_ends);
   } else {
     run(ends);

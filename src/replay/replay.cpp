@@ -177,7 +177,7 @@ class Replay {
 
  private:
   bool open_outputs();
-  Processed process(FrameJob& job);
+  void process(FrameJob& job, Processed& out);  // over the slot's earlier result (OrderedPool::ProcessInto)
   void deliver(const Pool::Result& r);
   void write_frame(const Pool::Result& r);
   void decide(const Pool::Result& r, const LidarFrame& f, perception::FrameResult& result);
@@ -275,7 +275,7 @@ bool Replay::open() {
   sync::PoolParams pool_params;
   pool_params.workers = workers_;
   pool_params.queue_capacity = static_cast<std::size_t>(cfg_.pipeline.queue_capacity);
-  pool_.emplace(pool_params, [this](FrameJob& job) { return process(job); });
+  pool_.emplace(pool_params, [this](FrameJob& job, Processed& out) { process(job, out); });
   progress_ = !opt_.quiet && isatty(STDERR_FILENO) != 0;
   return true;
 }
@@ -317,18 +317,19 @@ bool Replay::open_outputs() {
 // On a worker: compensation, perception, and the bird's-eye picture (it needs that worker's pipeline).
 // Everything that is written happens in deliver(), on the reading thread, in frame order: the output does not
 // depend on the number of workers.
-Processed Replay::process(FrameJob& job) {
-  Processed out;
+void Replay::process(FrameJob& job, Processed& out) {
+  out.bev.reset();
   if (!detectors_) {
-    out.det.frame = std::move(job.rotation);
-    return out;
+    std::swap(out.det.frame, job.rotation);
+    out.det.result = perception::FrameResult{};
+    out.det.fusion.reset();
+    return;
   }
   const DetectorSet::Lease detector(*detectors_);
-  out.det = detector->process(job, detect_);
+  detector->process(job, out.det, detect_);
   if (!bev_dir_.empty()) {
     out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg_.perception, std::nullopt);
   }
-  return out;
 }
 
 void Replay::deliver(const Pool::Result& r) {
@@ -405,6 +406,7 @@ void Replay::submit_jobs() {
   for (auto& j : jobs_) {
     // Back-pressure instead of a drop: replay must lose no frame, so a full queue waits for results.
     while (!pool_->try_submit(j)) pool_->poll_wait(deliver);
+    fusion_->recycle(j);  // the slot's earlier job, handed back
     pool_->poll(deliver);
   }
   jobs_.clear();

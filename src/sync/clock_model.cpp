@@ -97,6 +97,11 @@ void ClockModel::add_pair(std::int64_t sensor_ns, Stamp host) {
       b.y = y;
     }
   } else {
+    if (buckets_.full()) {  // a full ring would drop its first bucket: grow it (the iterator with it)
+      const auto at = it - buckets_.begin();
+      buckets_.set_capacity(2 * buckets_.capacity());
+      it = buckets_.begin() + at;
+    }
     buckets_.insert(it, Bucket{index, x, y});
   }
   const double newest = buckets_.back().x;
@@ -116,8 +121,8 @@ void ClockModel::refit() {
     return;
   }
   // Lower convex hull of the bucket minima (monotone chain; they are sorted by x).
-  std::vector<const Bucket*> hull;
-  hull.reserve(buckets_.size());
+  std::vector<const Bucket*>& hull = hull_;
+  hull.clear();
   for (const Bucket& b : buckets_) {
     while (hull.size() >= 2) {
       const Bucket& p = *hull[hull.size() - 2];

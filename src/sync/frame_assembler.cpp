@@ -140,8 +140,11 @@ void FrameAssembler::close_open(bool partial) {
   w.end = open_.back().end;
   w.partial = partial;
   for (const LidarRotation& r : open_) w.partial = w.partial || r.partial;
-  w.rotations = std::move(open_);
-  open_.clear();
+  w.rotations.swap(open_);
+  if (!spare_lists_.empty()) {  // the next window's rotations go into an earlier window's list: no allocation
+    open_.swap(spare_lists_.back());
+    spare_lists_.pop_back();
+  }
   pending_.push_back(std::move(w));
 }
 
@@ -214,20 +217,43 @@ std::optional<SensorKind> FrameAssembler::waiting_for() const {
   return std::nullopt;
 }
 
+void FrameAssembler::recycle(SyncedFrame&& frame) {
+  if (spare_frames_.size() < kMaxSpare) spare_frames_.push_back(std::move(frame));
+}
+
+bool FrameAssembler::take_spare_points(std::vector<LidarPoint>& out) {
+  if (spare_points_.empty()) return false;
+  out = std::move(spare_points_.back());
+  spare_points_.pop_back();
+  return true;
+}
+
 SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   SyncedFrame f;
+  if (!spare_frames_.empty()) {
+    f = std::move(spare_frames_.back());
+    spare_frames_.pop_back();
+  }
   f.seq = next_seq_++;
   f.window_start = w.start;
   f.window_end = w.end;
+  f.last_packet_host = Stamp{};
   f.partial = w.partial;
   f.timed_out = timed_out;
+  f.missing = 0;
   f.rotations = static_cast<std::uint32_t>(w.rotations.size());
   for (const LidarRotation& r : w.rotations) f.last_packet_host = std::max(f.last_packet_host, r.last_host);
-  // The first rotation starts the window: its points are taken over as they are (no copy at 5 Hz spin); the
-  // others are appended with their times shifted onto the window's start.
+  // The first rotation starts the window: its points are taken over as they are (no copy at 5 Hz spin) unless the
+  // recycled frame's buffer has the room its rotation's lacks; the others are appended with their times shifted
+  // onto the window's start. Every buffer left over goes back to the rotation assembler (take_spare_points()).
   std::size_t n = 0;
   for (const LidarRotation& r : w.rotations) n += r.points.size();
-  f.points = std::move(w.rotations.front().points);
+  std::vector<LidarPoint>& first = w.rotations.front().points;
+  if (first.capacity() >= n || f.points.capacity() < n) {
+    f.points.swap(first);
+  } else {
+    f.points.assign(first.begin(), first.end());
+  }
   f.points.reserve(n);
   for (std::size_t i = 1; i < w.rotations.size(); ++i) {
     const LidarRotation& r = w.rotations[i];
@@ -237,6 +263,14 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
       f.points.push_back(p);
     }
   }
+  for (LidarRotation& r : w.rotations) {
+    if (r.points.capacity() > 0 && spare_points_.size() < kMaxSpare) {
+      r.points.clear();
+      spare_points_.push_back(std::move(r.points));
+    }
+  }
+  w.rotations.clear();
+  if (spare_lists_.size() < kMaxSpare) spare_lists_.push_back(std::move(w.rotations));
 
   const Stamp mid = f.middle();
   if (!scans_.empty()) {
@@ -245,7 +279,13 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
     if (it == scans_.end() || (it != scans_.begin() && mid.ns - std::prev(it)->time.ns <= it->time.ns - mid.ns)) {
       --it;
     }
-    if (std::llabs(it->time.ns - mid.ns) <= to_ns(params_.max_scan_offset_s)) f.scan2d = *it;
+    if (std::llabs(it->time.ns - mid.ns) <= to_ns(params_.max_scan_offset_s)) {
+      f.scan2d = *it;  // over a recycled frame's scan: its vectors keep their room
+    } else {
+      f.scan2d.reset();
+    }
+  } else {
+    f.scan2d.reset();
   }
   if (params_.require_scan2d && !f.scan2d) f.missing |= bit(SensorKind::Scan2d);
   const std::int64_t gap = to_ns(params_.max_bracket_gap_s);
@@ -282,7 +322,7 @@ void FrameAssembler::poll(Stamp now, std::vector<SyncedFrame>& out) {
     if (nr != 0 && !overflow && !expired) break;
     if (nr != 0 && overflow && !expired) ++counters_.overflowed;
     Window w = std::move(pending_.front());
-    pending_.pop_front();
+    pending_.erase(pending_.begin());
     out.push_back(build(std::move(w), nr != 0));
   }
 }
@@ -292,7 +332,7 @@ void FrameAssembler::finish(std::vector<SyncedFrame>& out) {
   while (!pending_.empty()) {
     const std::uint8_t nr = not_ready(pending_.front());
     Window w = std::move(pending_.front());
-    pending_.pop_front();
+    pending_.erase(pending_.begin());
     out.push_back(build(std::move(w), nr != 0));
   }
 }

@@ -21,6 +21,7 @@ void HealthMonitor::sample(SensorKind k, Stamp host) {
   ++h.samples;
   if (!h.last_host || *h.last_host < host) h.last_host = host;
   auto& recent = tracks_[index(k)].recent;
+  if (recent.full()) recent.set_capacity(2 * recent.capacity());
   recent.push_back(host.ns);
   // Keep the window behind the newest time; the bound also caps memory for a sensor flooding the link.
   const std::int64_t newest = h.last_host->ns;

@@ -641,6 +641,53 @@ TEST(FrameCompensator, OutputIsClearedAndReused) {
   EXPECT_EQ(out.stats.gnss_used, 0U);
 }
 
+// The working storage travels with the output (a worker reuses both): nothing of one frame, nor of another
+// compensator's track limits, leaks into the next: bit for bit what a fresh output gives.
+TEST(FrameCompensator, ReusedWorkGivesWhatAFreshOutputGives) {
+  const CompensationParams params = base_params();
+  CompensationParams strict = params;
+  strict.track.max_attitude_gap_s = 0.005;  // every AHRS gap a dropout: points dropped
+  const FrameCompensator comp(params);
+  const FrameCompensator other(strict);
+  const Truth truth;
+  sync::SyncedFrame f = make_frame(truth, params);
+  f.points = ground_seen(truth, params.lidar);
+  FrameOptions gap;
+  gap.ahrs_gap_from = 0.05;
+  gap.ahrs_gap_to = 0.12;
+  sync::SyncedFrame g = make_frame(truth, params, gap);
+  g.points = f.points;
+  const auto same = [](const CompensatedFrame& a, const CompensatedFrame& b) {
+    ASSERT_EQ(a.levelling, b.levelling);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    for (std::size_t i = 0; i < a.points.size(); ++i) {
+      ASSERT_EQ(a.points[i].x, b.points[i].x);
+      ASSERT_EQ(a.points[i].y, b.points[i].y);
+      ASSERT_EQ(a.points[i].z, b.points[i].z);
+    }
+    EXPECT_EQ(a.stats.gnss_used, b.stats.gnss_used);
+    EXPECT_EQ(a.stats.ahrs_used, b.stats.ahrs_used);
+    EXPECT_EQ(a.stats.lidar.points_out, b.stats.lidar.points_out);
+  };
+  CompensatedFrame fresh_f;
+  CompensatedFrame fresh_g;
+  CompensatedFrame fresh_other;
+  comp.compensate(f, fresh_f);
+  comp.compensate(g, fresh_g);
+  other.compensate(f, fresh_other);
+  ASSERT_NE(fresh_f.stats.lidar.points_out, fresh_other.stats.lidar.points_out) << "the limits make a difference";
+  CompensatedFrame reused;
+  comp.compensate(g, reused);
+  comp.compensate(f, reused);
+  same(reused, fresh_f);
+  comp.compensate(g, reused);
+  same(reused, fresh_g);
+  other.compensate(f, reused);
+  same(reused, fresh_other);
+  comp.compensate(f, reused);
+  same(reused, fresh_f);
+}
+
 TEST(FrameCompensator, ValidateRejectsBadParameters) {
   EXPECT_TRUE(base_params().validate().empty());
   EXPECT_NO_THROW(FrameCompensator{base_params()});

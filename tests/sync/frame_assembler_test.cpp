@@ -107,13 +107,18 @@ std::vector<SyncedFrame> run(FrameAssembler& fa, const Scenario& sc, const std::
   return out;
 }
 
-void check_frame(const SyncedFrame& f, std::int64_t rotation_ns) {
+// Points: every rotation of the window, times relative to the window's start and increasing.
+void check_frame_points(const SyncedFrame& f, std::int64_t rotation_ns) {
   SCOPED_TRACE(f.seq);
-  // Points: every rotation of the window, times relative to the window's start and increasing.
   ASSERT_EQ(f.points.size(), 100U * f.rotations);
   for (std::size_t i = 1; i < f.points.size(); ++i) ASSERT_GT(f.points[i].time_s, f.points[i - 1].time_s);
   EXPECT_FLOAT_EQ(f.points.front().time_s, 0.F);
   EXPECT_NEAR(f.points.back().time_s, static_cast<double>(f.rotations * rotation_ns - rotation_ns / 100) * 1e-9, 1e-5);
+}
+
+void check_frame(const SyncedFrame& f, std::int64_t rotation_ns) {
+  SCOPED_TRACE(f.seq);
+  check_frame_points(f, rotation_ns);
   // The scan nearest to the middle: scans are 25 ms apart, so within 12.5 ms, and no other is nearer.
   ASSERT_TRUE(f.scan2d.has_value());
   const std::int64_t d = std::llabs(f.scan2d->time.ns - f.middle().ns);
@@ -480,6 +485,51 @@ TEST(FrameAssembler, ALeadNeedsTwoRecentEpochs) {
     EXPECT_TRUE(out[0].timed_out);
     EXPECT_TRUE(out[0].is_missing(SensorKind::Gnss));
   }
+}
+
+// Frames handed back (recycle()) hold later frames, and the rotations copied into a frame come back for the
+// rotation assembler (take_spare_points()): once warm, a stream of two-rotation frames uses the same few buffers.
+TEST(FrameAssembler, RecycledFramesAndRotationBuffersAreReused) {
+  Scenario sc;
+  sc.with_scan = false;
+  AssemblerParams p;
+  p.require_scan2d = false;
+  FrameAssembler fa(p);
+  std::vector<SyncedFrame> out;
+  std::vector<std::vector<LidarPoint>> spare;  // what a rotation assembler would reuse
+  std::vector<const LidarPoint*> frame_buffers;
+  std::size_t frames = 0;
+  for (const Event& e : events(sc)) {
+    switch (e.kind) {
+      case 0: {
+        LidarRotation r = rotation(e.index, e.t, sc.rotation_ns);
+        if (!spare.empty()) {  // the points go into a handed-back buffer, as RotationAssembler::recycle() does
+          std::vector<LidarPoint> b = std::move(spare.back());
+          spare.pop_back();
+          b.assign(r.points.begin(), r.points.end());
+          r.points = std::move(b);
+        }
+        fa.add_rotation(std::move(r));
+        break;
+      }
+      case 2: fa.add_gnss(gnss_at(e.t)); break;
+      case 3: fa.add_attitude(ahrs_at(e.t)); break;
+      default: break;
+    }
+    fa.poll(Stamp{e.rx}, out);
+    for (SyncedFrame& f : out) {
+      check_frame_points(f, sc.rotation_ns);
+      if (++frames > 3) frame_buffers.push_back(f.points.data());
+      fa.recycle(std::move(f));
+    }
+    out.clear();
+    std::vector<LidarPoint> b;
+    while (fa.take_spare_points(b)) spare.push_back(std::move(b));
+  }
+  ASSERT_GE(frames, 14U);
+  std::sort(frame_buffers.begin(), frame_buffers.end());
+  const auto distinct = std::unique(frame_buffers.begin(), frame_buffers.end()) - frame_buffers.begin();
+  EXPECT_LE(distinct, 4) << "frames after the third in new buffers";
 }
 
 TEST(AssemblerParams, ALeadIsWithinTheBracketGap) {

@@ -93,8 +93,12 @@ struct DetectedFrame {
 class FrameDetector {
  public:
   explicit FrameDetector(const Config& cfg);
-  // Consumes the job's points (moved into the result). detect = false: compensation only (points to write).
+  // detect = false: compensation only (points to write).
   [[nodiscard]] DetectedFrame process(FrameJob& job, bool detect = true);
+  // The same into `d`, an earlier frame's result whose buffers are reused: once warm, nothing is allocated. The
+  // job keeps its own points (a fused frame's raw points; a rotation's trade places with d's earlier points), for
+  // the producer to recycle (SensorFusion::recycle()).
+  void process(FrameJob& job, DetectedFrame& d, bool detect = true);
   [[nodiscard]] const perception::Pipeline& pipeline() const { return pipeline_; }
 
  private:
@@ -161,6 +165,9 @@ class SensorFusion {
   void poll(Stamp now, std::vector<FrameJob>& out);
   // End of input: the rotation still open and every waiting window go out.
   void finish(Stamp now, std::vector<FrameJob>& out);
+  // A job the pool handed back (OrderedPool::submit() swaps in the slot's earlier input): its buffers go back to
+  // the 3D LiDAR's stream and the synchronizer, so that a steady stream allocates nothing once warm.
+  void recycle(FrameJob& job);
 
   [[nodiscard]] const velodyne::Stream& stream() const { return *stream_; }
   [[nodiscard]] const sync::Synchronizer* synchronizer() const { return sync_.get(); }

@@ -102,6 +102,25 @@ struct CompensationStats {
   std::size_t gnss_lever_nearest = 0;   // used with the nearest AHRS sample's attitude for the lever arm
 };
 
+// Working storage of FrameCompensator::compensate(), kept with the caller's CompensatedFrame: a caller that reuses
+// its frame allocates nothing once warm.
+struct CompensationWork {
+  struct Fix {  // one GGA fix that passed the checks, projected
+    Stamp t;
+    PlaneCoord plane;
+  };
+  struct AttSample {
+    Stamp t;
+    Eigen::Quaterniond q;
+  };
+  std::vector<Fix> fixes;
+  std::vector<AttSample> atts;
+  std::vector<SourcedPoint> lifted;  // the 2D scan in the 3D LiDAR's frame
+  std::vector<SourcedPoint> level;   // deskewed and levelled, before they become detection points
+  std::optional<PoseTrack> track;
+  const void* track_owner = nullptr;  // the compensator whose TrackParams built `track`
+};
+
 struct CompensatedFrame {
   Levelling levelling = Levelling::None;
   Stamp t_ref;  // the instant of the level frame: the window's end
@@ -115,6 +134,7 @@ struct CompensatedFrame {
   std::optional<PlaneCoord> reference;
   std::optional<EulerDeg> attitude;  // the vehicle's attitude at t_ref, plane frame (levelling != None)
   CompensationStats stats;
+  CompensationWork work;  // compensate()'s, not a result
 };
 
 class FrameCompensator {

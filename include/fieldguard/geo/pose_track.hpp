@@ -14,7 +14,6 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <vector>
 
@@ -71,6 +70,8 @@ class PoseTrack {
 
   // Forgets samples no longer needed to answer instants at or after t (keeps the one before t).
   void drop_before(Stamp t);
+  // Forgets every sample and count; the room stays for the next samples (a track reused frame after frame).
+  void clear();
 
   [[nodiscard]] std::size_t attitude_count() const { return att_.size(); }
   [[nodiscard]] std::size_t position_count() const { return pos_.size(); }
@@ -92,8 +93,8 @@ class PoseTrack {
   std::int64_t att_extra_ns_;
   std::int64_t pos_gap_ns_;
   std::int64_t pos_extra_ns_;
-  std::deque<AttSample> att_;
-  std::deque<PosSample> pos_;
+  std::vector<AttSample> att_;  // vectors, not deques: a cleared track refills without allocating
+  std::vector<PosSample> pos_;
   std::uint64_t rejected_order_ = 0;
   std::uint64_t rejected_finite_ = 0;
 };

@@ -26,6 +26,9 @@ class Pipeline {
   Pipeline& operator=(Pipeline&&) noexcept;
 
   [[nodiscard]] FrameResult process(std::span<const LidarPoint> points);
+  // The same into `result`, over an earlier frame's result whose vectors keep their room: once warm, a frame
+  // allocates nothing.
+  void process(std::span<const LidarPoint> points, FrameResult& result);
 
   // The 3D points of the last processed frame after ROI and voxel grid, labelled (no 2D point); valid until
   // the next process().

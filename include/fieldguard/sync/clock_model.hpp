@@ -23,11 +23,13 @@
 //
 // Pure: times are passed in, never read. Thread-compatible.
 
+#include <boost/circular_buffer.hpp>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "fieldguard/core/time.hpp"
 
@@ -138,7 +140,9 @@ class ClockModel {
   ClockParams params_;
   std::optional<std::int64_t> ref_;  // sensor ns of the reference point
   std::int64_t ref_offset_ns_ = 0;   // host - sensor of the first pair after a (re)seed
-  std::deque<Bucket> buckets_;
+  // A ring, grown (doubled) only when a longer window than ever needs it: a steady stream allocates nothing.
+  boost::circular_buffer<Bucket> buckets_ = boost::circular_buffer<Bucket>(16);
+  std::vector<const Bucket*> hull_;  // refit()'s scratch
   double a_ = 0.0;  // fitted y at x = 0
   double skew_ = 0.0;
   std::deque<Suspect> suspects_;

@@ -70,6 +70,13 @@ class FrameAssembler {
   // End of input: closes the rotations still open and emits every pending window as it is.
   void finish(std::vector<SyncedFrame>& out);
 
+  // Buffer reuse, so that a steady stream allocates nothing once warm. recycle(): a frame the consumer is done
+  // with; its vectors hold a later frame (its points buffer, sized for a whole window, takes the window's first
+  // rotation's place). take_spare_points(): the point buffers of rotations copied into a frame, emptied, for the
+  // 3D LiDAR's rotation assembler (RotationAssembler::recycle()); false when there is none. Both keep at most a few.
+  void recycle(SyncedFrame&& frame);
+  bool take_spare_points(std::vector<LidarPoint>& out);
+
   // The first required sensor the oldest closed window waits for; nullopt when no window is waiting.
   [[nodiscard]] std::optional<SensorKind> waiting_for() const;
   // Window end of the oldest closed window; nullopt when none waits.
@@ -95,7 +102,8 @@ class FrameAssembler {
   AssemblerParams params_;
   std::int64_t period_ns_ = 0;
   std::vector<LidarRotation> open_;  // rotations of the window being filled
-  std::deque<Window> pending_;       // closed, waiting for the other sensors
+  std::vector<Window> pending_;      // closed, waiting for the other sensors, oldest first (a few at most)
+  std::vector<std::vector<LidarRotation>> spare_lists_;  // emptied rotation lists of emitted windows, for open_
   std::deque<TimedScan> scans_;      // each sorted by time
   std::deque<TimedGnss> gnss_;
   std::deque<TimedAttitude> ahrs_;
@@ -103,6 +111,9 @@ class FrameAssembler {
   std::optional<Stamp> emitted_until_;  // end of the last emitted window
   std::uint64_t next_seq_ = 0;
   AssemblerCounters counters_;
+  std::vector<SyncedFrame> spare_frames_;               // recycled, at most kMaxSpare
+  std::vector<std::vector<LidarPoint>> spare_points_;  // at most kMaxSpare
+  static constexpr std::size_t kMaxSpare = 4;
 };
 
 }  // namespace fieldguard::sync

@@ -5,8 +5,8 @@
 // Pure: host times are passed in. Thread-compatible.
 
 #include <array>
+#include <boost/circular_buffer.hpp>
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 
@@ -51,7 +51,9 @@ class HealthMonitor {
  private:
   static std::size_t index(SensorKind k) { return static_cast<std::size_t>(k); }
   struct Track {
-    std::deque<std::int64_t> recent;  // receive times within the rate window of the last sample
+    // Receive times within the rate window of the last sample: a ring, grown (doubled) only when the window holds
+    // more than ever before, so a steady stream allocates nothing.
+    boost::circular_buffer<std::int64_t> recent = boost::circular_buffer<std::int64_t>(64);
   };
   std::int64_t window_ns_;
   std::array<SensorHealth, kSensorCount> sensors_{};

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
@@ -58,6 +59,9 @@ class Synchronizer {
 
   void poll(Stamp now, std::vector<SyncedFrame>& out);
   void finish(std::vector<SyncedFrame>& out);
+  // Buffer reuse (FrameAssembler::recycle(), take_spare_points()).
+  void recycle(SyncedFrame&& frame) { assembler_.recycle(std::move(frame)); }
+  bool take_spare_points(std::vector<LidarPoint>& out) { return assembler_.take_spare_points(out); }
 
   // The one-line status; names the sensor the oldest waiting window needs once it has waited waiting_grace_s,
   // or the 3D LiDAR when it has been silent for more than two frame periods.
