@@ -18,6 +18,7 @@
 #include "daemon/session.hpp"
 #include "daemon/systemd_notify.hpp"
 #include "fieldguard/config/config.hpp"
+#include "fieldguard/core/alloc_count.hpp"
 #include "fieldguard/core/exit_code.hpp"
 #include "fieldguard/daemon/daemon.hpp"
 #include "fieldguard/engine/logging.hpp"
@@ -167,6 +168,7 @@ void Daemon::arm_timer() {
 // (and the sink, when its kind, interface or file changed). Throws when even the previous configuration
 // cannot be restarted.
 void Daemon::reload() {
+  const alloc::Scope not_a_frame(alloc::Path::None);  // a new session is built: no frame's work
   notify_.reloading();
   log_->info("SIGHUP: reloading {}", opt_.config);
   auto fresh = load_config_file(opt_.config);
@@ -222,6 +224,9 @@ void Daemon::wait_signal() {
 void Daemon::loop() {
   arm_timer();
   wait_signal();
+  // What the io thread does outside a frame's path and the periodic tick is decoding the other sensors' samples
+  // (serial bytes, the 2D LiDAR's replies, the speed from the bus): counted as such (core/alloc_count.hpp).
+  const alloc::Scope samples(alloc::Path::Samples);
   io_.run();
 }
 

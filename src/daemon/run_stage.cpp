@@ -65,7 +65,7 @@ const safety::Decision& LiveStage::frame(const LidarFrame& f, const perception::
   const safety::Decision& d = *last_;
   ++counts_.frames;
   ++(d.stop ? counts_.stop_frames : counts_.go_frames);
-  note(d, ("rotation " + std::to_string(f.index)).c_str());
+  if (d.event) note(d, ("rotation " + std::to_string(f.index)).c_str());  // the label only when there is news
   output::FrameReport report;
   report.frame_counter = static_cast<std::uint32_t>(f.index);
   report.status = f.partial ? output::FrameStatus::PartialFrame : output::FrameStatus::Ok;

@@ -9,6 +9,7 @@
 #include <span>
 
 #include "daemon/source_options.hpp"
+#include "fieldguard/core/alloc_count.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/engine/stage_times.hpp"
 #include "fieldguard/output/can_speed.hpp"
@@ -42,7 +43,8 @@ Session::Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink,
       stage_(cfg_, sink),
       fusion_(cfg_, FusionInputs::enabled_in(cfg_)),
       detectors_(cfg_, static_cast<std::size_t>(cfg_.pipeline.workers)),
-      pool_(pool_params(cfg_, io, waker_), [this](FrameJob& j) { return process(j); }) {
+      pool_(pool_params(cfg_, io, waker_), [this](FrameJob& j, DetectedFrame& d) { process(j, d); }),
+      submitted_(pool_.params().queue_capacity + pool_.params().workers + pool_.params().reorder_slack + 1) {
   waker_->session = this;
 }
 
@@ -135,11 +137,15 @@ void Session::stop() {
 }
 
 void Session::on_results() {
+  const alloc::Scope frame_path(alloc::Path::Frame);
   pass_problems();
   pool_.poll([this](const Pool::Result& r) { deliver(r); });
 }
 
 void Session::on_tick(std::chrono::nanoseconds late) {
+  // Periodic work (the status line, heartbeats, timeouts) is no frame's: not counted, but for the frames it
+  // delivers and submits (their own scopes).
+  const alloc::Scope periodic(alloc::Path::None);
   io_gap_.add(late.count());
   if (!worker_refusal_logged_) {
     if (std::string refused = pool_.thread_refusal(); !refused.empty()) {
@@ -252,6 +258,18 @@ void Session::print_summary() const {
       u(late_), cfg_.realtime.latency_budget_ms);
   std::printf("  io loop           longest gap %.3f ms (a due timer waited that long for the io thread)\n",
               ms(io_gap_.max_ns()));
+  if (alloc::enabled()) {
+    if (warm_frame_allocs_) {
+      std::printf(
+          "  allocations       frame path %llu, sensor samples %llu, over the %llu frames after the first %llu "
+          "(once warm)\n",
+          u(alloc::count(alloc::Path::Frame) - *warm_frame_allocs_),
+          u(alloc::count(alloc::Path::Samples) - *warm_sample_allocs_), u(stage_.counts().frames - warm_frames_),
+          u(warm_frames_));
+    } else {
+      std::printf("  allocations       n/a (fewer than %llu frames decided)\n", u(kWarmFrames));
+    }
+  }
   if (!timed_.empty()) {
     const std::vector<perception::StageTimes> last(timed_.begin(), timed_.end());
     std::printf("  pipeline time     %s (the last %zu rotations); worst %.3f ms of all %llu\n",
@@ -277,9 +295,10 @@ sync::PoolParams Session::pool_params(const Config& c, boost::asio::io_context& 
   return p;
 }
 
-DetectedFrame Session::process(FrameJob& j) {
+void Session::process(FrameJob& j, DetectedFrame& d) {
+  const alloc::Scope frame_path(alloc::Path::Frame);
   const DetectorSet::Lease detector(detectors_);
-  return detector->process(j);
+  detector->process(j, d);
 }
 
 void Session::heard(safety::Sensor s, Stamp t) {
@@ -288,6 +307,7 @@ void Session::heard(safety::Sensor s, Stamp t) {
 }
 
 void Session::on_datagram(const io::UdpDatagram& d) {
+  const alloc::Scope frame_path(alloc::Path::Frame);
   stage_.sensor_data(safety::Sensor::Lidar, d.host_time);
   if (d.payload.size() != velodyne::kDataPacketSize) {
     if (bad_length_++ == 0) log_->warn("3D LiDAR: a {}-byte datagram is not a data packet (counted)", d.payload.size());
@@ -309,9 +329,11 @@ void Session::pass_problems() {
 }
 
 void Session::submit_jobs() {
+  const alloc::Scope frame_path(alloc::Path::Frame);
   for (auto& j : jobs_) {
     if (pool_.submit(j)) {
       submitted_.push_back(wall_clock_now());
+      fusion_.recycle(j);  // the slot's earlier job, handed back
     } else {
       ++lost_;
     }
@@ -320,6 +342,7 @@ void Session::submit_jobs() {
 }
 
 void Session::deliver(const Pool::Result& r) {
+  const alloc::Scope frame_path(alloc::Path::Frame);
   if (!submitted_.empty()) submitted_.pop_front();
   // Stopping: what the workers finish now must not follow the last STOP onto the bus.
   if (stopped_) return;
@@ -333,8 +356,7 @@ void Session::deliver(const Pool::Result& r) {
   }
   pass_problems();
   const perception::StageTimes& t = r.output->result.times;
-  if (timed_.size() == kTimedRotations) timed_.pop_front();
-  timed_.push_back(t);
+  timed_.push_back(t);  // over the oldest once full
   worst_us_ = std::max(worst_us_, t.total_us);
   ++timed_count_;
   // Frame to frame, so here in frame order (obstacle_hold.hpp); a rotation lost in between only ages what it
@@ -358,6 +380,11 @@ void Session::deliver(const Pool::Result& r) {
         static_cast<double>(latency_ns) * 1e-6, cfg_.realtime.latency_budget_ms);
   }
   if (ready_) notify_.progress(SteadyClock::now());
+  if (!warm_frame_allocs_ && stage_.counts().frames >= kWarmFrames) {
+    warm_frame_allocs_ = alloc::count(alloc::Path::Frame);
+    warm_sample_allocs_ = alloc::count(alloc::Path::Samples);
+    warm_frames_ = stage_.counts().frames;
+  }
 }
 
 }  // namespace fieldguard::app

@@ -5,9 +5,10 @@
 
 #include <atomic>
 #include <boost/asio/io_context.hpp>
+#include <boost/circular_buffer.hpp>
 #include <chrono>
 #include <cstdint>
-#include <deque>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -79,7 +80,7 @@ class Session {
   // The io thread, woken by a worker: the finished frames in order, each decided and its CAN frames written.
   void on_results();
 
-  DetectedFrame process(FrameJob& j);
+  void process(FrameJob& j, DetectedFrame& d);  // over the slot's earlier result (OrderedPool::ProcessInto)
 
   void heard(output::safety::Sensor s, Stamp t);
 
@@ -108,10 +109,13 @@ class Session {
   std::uint64_t speed_errors_ = 0;
   std::vector<std::unique_ptr<io::SerialReader>> serial_;
   std::vector<FrameJob> jobs_;
-  std::deque<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
+  // Rings, not deques: a frame pushes and pops without allocating. A frame outstanding holds a pool slot, so the
+  // slots bound the submit times kept.
+  boost::circular_buffer<Stamp> submitted_;  // submit times of the rotations not yet delivered, oldest first
   // The detection times of the status and the summary: the last 5 s at 10 Hz.
   static constexpr std::size_t kTimedRotations = 50;
-  std::deque<perception::StageTimes> timed_;  // Pipeline::process()'s of the last rotations delivered, oldest first
+  boost::circular_buffer<perception::StageTimes> timed_ =
+      boost::circular_buffer<perception::StageTimes>(kTimedRotations);  // the last rotations', oldest first
   float worst_us_ = 0.F;                      // the longest process() of the run
   std::uint64_t timed_count_ = 0;             // rotations delivered
   std::uint64_t lost_ = 0;                    // rotations dropped, refused or failed
@@ -122,6 +126,11 @@ class Session {
   LatencyStats io_gap_;     // per tick: how late the output timer ran
   std::uint64_t late_ = 0;  // frames over realtime.latency_budget_ms
   bool worker_refusal_logged_ = false;
+  // Allocations counted (core/alloc_count.hpp) when the kWarmFrames-th frame was decided: the summary's are those
+  // after it, once warm.
+  static constexpr std::uint64_t kWarmFrames = 10;
+  std::optional<std::uint64_t> warm_frame_allocs_, warm_sample_allocs_;
+  std::uint64_t warm_frames_ = 0;  // frames decided when they were taken
   bool stopped_ = false;
   SteadyClock::time_point last_status_{};
 };

@@ -355,6 +355,13 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     ASSERT_NE(worst, std::string::npos) << line;
     EXPECT_GT(std::stod(line.substr(worst + 8)), 0.0) << line;
     std::printf("[ measured ] %s\n", line.substr(2).c_str());
+    // The binary counts its frame path's heap allocations once warm (core/alloc_count.hpp) and says how many.
+    const std::string allocs = "  allocations       frame path ";
+    const auto al = out.find(allocs);
+    ASSERT_NE(al, std::string::npos) << out;
+    const std::string alloc_line = out.substr(al + 2, out.find('\n', al) - al - 2);
+    EXPECT_NE(alloc_line.find("sensor samples "), std::string::npos) << alloc_line;
+    std::printf("[ measured ] %s\n", alloc_line.c_str());
     // The hold is on in fieldguard.yaml: the daemon runs it, in frame order, and counts what it held.
     const std::string held = "  held obstacles    ";
     const auto h = out.find(held);

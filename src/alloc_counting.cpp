@@ -1,0 +1,85 @@
+// The fieldguard binary's global operator new and delete: malloc and free, as the library's are, plus a count of
+// the allocations made inside an alloc::Scope (core/alloc_count.hpp), so that the daemon can say how many its
+// frame path made once warm. Every form of new is replaced, so that no allocation escapes the count.
+#include <cstdlib>
+#include <new>
+
+#include "fieldguard/core/alloc_count.hpp"
+
+namespace {
+
+// Enabled before main(): the daemon's summary prints the counts only where this file is linked.
+[[maybe_unused]] const bool kEnabled = [] {
+  fieldguard::alloc::enable();
+  return true;
+}();
+
+void* allocate(std::size_t n) {
+  fieldguard::alloc::note_allocation();
+  for (;;) {
+    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+    const std::new_handler h = std::get_new_handler();
+    if (h == nullptr) throw std::bad_alloc();
+    h();
+  }
+}
+
+void* allocate_aligned(std::size_t n, std::align_val_t al) {
+  fieldguard::alloc::note_allocation();
+  const auto a = static_cast<std::size_t>(al);
+  const std::size_t size = ((n == 0 ? 1 : n) + a - 1) / a * a;  // aligned_alloc wants a multiple of the alignment
+  for (;;) {
+    if (void* p = std::aligned_alloc(a, size)) return p;
+    const std::new_handler h = std::get_new_handler();
+    if (h == nullptr) throw std::bad_alloc();
+    h();
+  }
+}
+
+}  // namespace
+
+void* operator new(std::size_t n) { return allocate(n); }
+void* operator new[](std::size_t n) { return allocate(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return allocate(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
+  try {
+    return allocate(n);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new(std::size_t n, std::align_val_t al) { return allocate_aligned(n, al); }
+void* operator new[](std::size_t n, std::align_val_t al) { return allocate_aligned(n, al); }
+void* operator new(std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept {
+  try {
+    return allocate_aligned(n, al);
+  } catch (...) {
+    return nullptr;
+  }
+}
+void* operator new[](std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept {
+  try {
+    return allocate_aligned(n, al);
+  } catch (...) {
+    return nullptr;
+  }
+}
+
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
