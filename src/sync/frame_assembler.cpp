@@ -258,16 +258,15 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   for (std::size_t i = 1; i < w.rotations.size(); ++i) {
     const LidarRotation& r = w.rotations[i];
     const auto shift = static_cast<float>(static_cast<double>(r.start.ns - w.start.ns) * 1e-9);
-    for (LidarPoint p : r.points) {
-      p.time_s += shift;
-      f.points.push_back(p);
-    }
+    // Copied as a block, then the times shifted: a point-by-point push_back was a tenth of the io thread's time.
+    const std::size_t at = f.points.size();
+    f.points.insert(f.points.end(), r.points.begin(), r.points.end());
+    for (std::size_t k = at; k < f.points.size(); ++k) f.points[k].time_s += shift;
   }
   for (LidarRotation& r : w.rotations) {
-    if (r.points.capacity() > 0 && spare_points_.size() < kMaxSpare) {
-      r.points.clear();
-      spare_points_.push_back(std::move(r.points));
-    }
+    // Not cleared: the rotation assembler writes over the points it holds (RotationAssembler::recycle()) instead
+    // of constructing them again.
+    if (r.points.capacity() > 0 && spare_points_.size() < kMaxSpare) spare_points_.push_back(std::move(r.points));
   }
   w.rotations.clear();
   if (spare_lists_.size() < kMaxSpare) spare_lists_.push_back(std::move(w.rotations));

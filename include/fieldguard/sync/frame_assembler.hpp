@@ -72,8 +72,9 @@ class FrameAssembler {
 
   // Buffer reuse, so that a steady stream allocates nothing once warm. recycle(): a frame the consumer is done
   // with; its vectors hold a later frame (its points buffer, sized for a whole window, takes the window's first
-  // rotation's place). take_spare_points(): the point buffers of rotations copied into a frame, emptied, for the
-  // 3D LiDAR's rotation assembler (RotationAssembler::recycle()); false when there is none. Both keep at most a few.
+  // rotation's place). take_spare_points(): the point buffers of rotations copied into a frame (their points stale),
+  // for the 3D LiDAR's rotation assembler (RotationAssembler::recycle()); false when there is none. Both keep at most
+  // a few.
   void recycle(SyncedFrame&& frame);
   bool take_spare_points(std::vector<LidarPoint>& out);
 
