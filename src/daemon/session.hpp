@@ -8,8 +8,8 @@
 #include <boost/circular_buffer.hpp>
 #include <chrono>
 #include <cstdint>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -116,9 +116,9 @@ class Session {
   static constexpr std::size_t kTimedRotations = 50;
   boost::circular_buffer<perception::StageTimes> timed_ =
       boost::circular_buffer<perception::StageTimes>(kTimedRotations);  // the last rotations', oldest first
-  float worst_us_ = 0.F;                      // the longest process() of the run
-  std::uint64_t timed_count_ = 0;             // rotations delivered
-  std::uint64_t lost_ = 0;                    // rotations dropped, refused or failed
+  float worst_us_ = 0.F;                                                // the longest process() of the run
+  std::uint64_t timed_count_ = 0;                                       // rotations delivered
+  std::uint64_t lost_ = 0;                                              // rotations dropped, refused or failed
   std::uint64_t bad_length_ = 0;
   bool heard_all_ = false;
   bool stalled_ = false;

@@ -437,8 +437,8 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
       // STOP of its own, right whatever the zone says: on this loaded 2-core machine the pseudo-terminals are
       // sometimes not read for that long (README, Measurements). So is a frame decided more than the deadline
       // (0.3 s) after its last data: fused, a frame waits for a GNSS fix when the newest is too old to extrapolate
-      // from, which happens when the pseudo-terminals are read late (seen once in CI: rotations 63-64 pipeline late, beside 14
-      // sensor-fault frames). Such frames are counted, not held to GO; a daemon late on every frame still
+      // from, which happens when the pseudo-terminals are read late (seen once in CI: rotations 63-64 pipeline late,
+      // beside 14 sensor-fault frames). Such frames are counted, not held to GO; a daemon late on every frame still
       // fails the count of GOs below.
       if (fused && s.command == 1 && (s.sensor_fault || s.pipeline_late) && !s.obstacle) {
         ++late_or_fault_frames;

@@ -320,8 +320,8 @@ TEST(RotationAssembler, AnUnsteadyStepWaitsForTheNextRotation) {
 // Real captures, whose cut falls where the packets put it: the same frames either way.
 TEST(RotationAssembler, RealCapturesGiveTheSameRotationsEitherWay) {
   using namespace velodyne;
-  for (const auto& [file, model] : {std::pair{"hdl32e_monterey_600.pcap", Model::HDL32E},
-                                    std::pair{"vlp16_veloview_300.pcap", Model::VLP16}}) {
+  for (const auto& [file, model] :
+       {std::pair{"hdl32e_monterey_600.pcap", Model::HDL32E}, std::pair{"vlp16_veloview_300.pcap", Model::VLP16}}) {
     SCOPED_TRACE(file);
     const auto packets = test::read_data_packets(test::test_data(file));
     DecoderOptions o;

@@ -143,7 +143,7 @@ class ClockModel {
   // A ring, grown (doubled) only when a longer window than ever needs it: a steady stream allocates nothing.
   boost::circular_buffer<Bucket> buckets_ = boost::circular_buffer<Bucket>(16);
   std::vector<const Bucket*> hull_;  // refit()'s scratch
-  double a_ = 0.0;  // fitted y at x = 0
+  double a_ = 0.0;                   // fitted y at x = 0
   double skew_ = 0.0;
   std::deque<Suspect> suspects_;
   std::uint64_t jumps_ = 0;

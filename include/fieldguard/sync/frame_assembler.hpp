@@ -105,14 +105,14 @@ class FrameAssembler {
   std::vector<LidarRotation> open_;  // rotations of the window being filled
   std::vector<Window> pending_;      // closed, waiting for the other sensors, oldest first (a few at most)
   std::vector<std::vector<LidarRotation>> spare_lists_;  // emptied rotation lists of emitted windows, for open_
-  std::deque<TimedScan> scans_;      // each sorted by time
+  std::deque<TimedScan> scans_;                          // each sorted by time
   std::deque<TimedGnss> gnss_;
   std::deque<TimedAttitude> ahrs_;
   std::optional<Stamp> last_rotation_end_;
   std::optional<Stamp> emitted_until_;  // end of the last emitted window
   std::uint64_t next_seq_ = 0;
   AssemblerCounters counters_;
-  std::vector<SyncedFrame> spare_frames_;               // recycled, at most kMaxSpare
+  std::vector<SyncedFrame> spare_frames_;              // recycled, at most kMaxSpare
   std::vector<std::vector<LidarPoint>> spare_points_;  // at most kMaxSpare
   static constexpr std::size_t kMaxSpare = 4;
 };

@@ -362,7 +362,7 @@ class OrderedPool {
   std::string refusal_;
   std::atomic<bool> has_refusal_{false};  // refusal_ is set
   // Consumer only.
-  std::vector<Slot*> waiting_;  // finished, by ticket modulo its size (the slots'), until their turn
+  std::vector<Slot*> waiting_;              // finished, by ticket modulo its size (the slots'), until their turn
   std::atomic<std::uint64_t> next_out_{0};  // written by the consumer only; atomic for counters()
 };
 

@@ -64,12 +64,12 @@ struct TimedAttitude {
 };
 
 struct SyncedFrame {
-  std::uint64_t seq = 0;            // 0, 1, 2, ... in emission order, no gaps
-  Stamp window_start;               // first firing of the first rotation
-  Stamp window_end;                 // last firing of the last rotation
-  Stamp last_packet_host;           // receive time of the window's last 3D LiDAR packet: a decision's latency starts here
-  std::uint32_t rotations = 0;      // whole rotations in the window (1 at 5 Hz spin, 2 at 10 Hz, ...)
-  bool partial = false;             // a rotation was partial (stream start or end) or the window is short of a period
+  std::uint64_t seq = 0;        // 0, 1, 2, ... in emission order, no gaps
+  Stamp window_start;           // first firing of the first rotation
+  Stamp window_end;             // last firing of the last rotation
+  Stamp last_packet_host;       // receive time of the window's last 3D LiDAR packet: a decision's latency starts here
+  std::uint32_t rotations = 0;  // whole rotations in the window (1 at 5 Hz spin, 2 at 10 Hz, ...)
+  bool partial = false;         // a rotation was partial (stream start or end) or the window is short of a period
   std::vector<LidarPoint> points;   // time_s relative to window_start
   std::optional<TimedScan> scan2d;  // the scan nearest to the window's middle
   std::vector<TimedGnss> gnss;      // from the last epoch at or before window_start to the first at or after window_end
