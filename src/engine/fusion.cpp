@@ -181,8 +181,12 @@ void SensorFusion::frames_to(Stamp host, std::vector<FrameJob>& out) {
   sync_->poll(host, frames_);
   jobs_from_frames(host, out);
   // The buffers of rotations copied into a frame, back to the stream for later rotations.
-  LidarFrame spare;
-  while (sync_->take_spare_points(spare.points)) stream_->recycle(std::move(spare));
+  std::vector<LidarPoint> points;
+  while (sync_->take_spare_points(points)) {
+    LidarFrame spare;
+    spare.points.swap(points);
+    stream_->recycle(std::move(spare));
+  }
 }
 
 void SensorFusion::recycle(FrameJob& job) {
