@@ -275,18 +275,21 @@ TEST(RotationAssembler, ARotationEndingBetweenPacketsIsEmittedWithItsLastPacket)
   EXPECT_TRUE(late.back().partial) << "waiting for a next rotation that never comes, finish() emits it partial";
 }
 
+// A packet of 24 firings 0.25 degree apart, the first at `first_cdeg`.
+void push_steady_packet(RotationAssembler& a, int first_cdeg, std::vector<LidarFrame>& done) {
+  std::vector<LidarPoint> pts(24);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].azimuth_cdeg = static_cast<std::uint16_t>((first_cdeg + 25 * static_cast<int>(i)) % 36000);
+  }
+  a.push(pts, Stamp{1}, Stamp{1}, done);
+}
+
 // The step is predicted; where the next packet after all starts a little before the cut (the sensor's spin wavered),
 // its firings join the next rotation, like per-laser corrections right after a cut: no frame of a few points.
 TEST(RotationAssembler, AMissedPredictionMovesAFewFiringsToTheNextRotation) {
   RotationAssembler a(0.0);
   std::vector<LidarFrame> done;
-  auto packet = [&](int first_cdeg) {
-    std::vector<LidarPoint> pts(24);
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      pts[i].azimuth_cdeg = static_cast<std::uint16_t>((first_cdeg + 25 * static_cast<int>(i)) % 36000);
-    }
-    a.push(pts, Stamp{1}, Stamp{1}, done);
-  };
+  auto packet = [&](int first_cdeg) { push_steady_packet(a, first_cdeg, done); };
   for (int first = 0; first < 36000; first += 600) packet(first);  // a whole turn, the last packet at 354 deg
   ASSERT_EQ(done.size(), 1U) << "emitted with its last packet";
   packet(35990);  // 0.1 deg short of the predicted start
@@ -303,13 +306,7 @@ TEST(RotationAssembler, AMissedPredictionMovesAFewFiringsToTheNextRotation) {
 TEST(RotationAssembler, AnUnsteadyStepWaitsForTheNextRotation) {
   RotationAssembler a(0.0);
   std::vector<LidarFrame> done;
-  auto packet = [&](int first_cdeg) {
-    std::vector<LidarPoint> pts(24);
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      pts[i].azimuth_cdeg = static_cast<std::uint16_t>((first_cdeg + 25 * static_cast<int>(i)) % 36000);
-    }
-    a.push(pts, Stamp{1}, Stamp{1}, done);
-  };
+  auto packet = [&](int first_cdeg) { push_steady_packet(a, first_cdeg, done); };
   for (int first = 0; first < 34800; first += 600) packet(first);
   packet(35400);  // the one at 348 deg lost: a step of 1200 after steps of 600
   EXPECT_TRUE(done.empty());

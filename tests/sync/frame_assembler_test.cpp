@@ -92,15 +92,20 @@ std::vector<Event> events(const Scenario& sc) {
   return ev;
 }
 
+// One event into the assembler.
+void feed(FrameAssembler& fa, const Scenario& sc, const Event& e) {
+  switch (e.kind) {
+    case 0: fa.add_rotation(rotation(e.index, e.t, sc.rotation_ns)); break;
+    case 1: fa.add_scan(scan_at(e.t)); break;
+    case 2: fa.add_gnss(gnss_at(e.t)); break;
+    default: fa.add_attitude(ahrs_at(e.t)); break;
+  }
+}
+
 std::vector<SyncedFrame> run(FrameAssembler& fa, const Scenario& sc, const std::vector<Event>& ev, bool finish = true) {
   std::vector<SyncedFrame> out;
   for (const Event& e : ev) {
-    switch (e.kind) {
-      case 0: fa.add_rotation(rotation(e.index, e.t, sc.rotation_ns)); break;
-      case 1: fa.add_scan(scan_at(e.t)); break;
-      case 2: fa.add_gnss(gnss_at(e.t)); break;
-      default: fa.add_attitude(ahrs_at(e.t)); break;
-    }
+    feed(fa, sc, e);
     fa.poll(Stamp{e.rx}, out);
   }
   if (finish) fa.finish(out);
@@ -402,12 +407,7 @@ std::vector<Left> run_timed(FrameAssembler& fa, const Scenario& sc, const std::v
   std::vector<Left> left;
   std::vector<SyncedFrame> out;
   for (const Event& e : ev) {
-    switch (e.kind) {
-      case 0: fa.add_rotation(rotation(e.index, e.t, sc.rotation_ns)); break;
-      case 1: fa.add_scan(scan_at(e.t)); break;
-      case 2: fa.add_gnss(gnss_at(e.t)); break;
-      default: fa.add_attitude(ahrs_at(e.t)); break;
-    }
+    feed(fa, sc, e);
     fa.poll(Stamp{e.rx}, out);
     for (SyncedFrame& f : out) left.push_back({std::move(f), e.rx});
     out.clear();
