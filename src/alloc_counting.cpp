@@ -6,6 +6,20 @@
 
 #include "fieldguard/core/alloc_count.hpp"
 
+// ThreadSanitizer and MemorySanitizer link their own operator new and delete statically: a second definition does
+// not link. Their builds count nothing (alloc::enabled() stays false and the summary leaves the line out).
+#if defined(__SANITIZE_THREAD__)
+#define FIELDGUARD_OWN_NEW 0
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define FIELDGUARD_OWN_NEW 0
+#endif
+#endif
+#ifndef FIELDGUARD_OWN_NEW
+#define FIELDGUARD_OWN_NEW 1
+#endif
+
+#if FIELDGUARD_OWN_NEW
 namespace {
 
 // Enabled before main(): the daemon's summary prints the counts only where this file is linked.
@@ -83,3 +97,4 @@ void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::fre
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+#endif  // FIELDGUARD_OWN_NEW
