@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "fieldguard/geo/attitude.hpp"
+#include "geo/round.hpp"
 
 namespace fieldguard::geo {
 
@@ -94,7 +95,7 @@ DeskewStats run(std::span<const P> points, Stamp base, const PoseTrack& track, c
       ++stats.dropped_not_finite;
       continue;
     }
-    const std::int64_t t_ns = base.ns + std::llround(static_cast<double>(m.time_s) * 1e9);
+    const std::int64_t t_ns = base.ns + round_half_away(static_cast<double>(m.time_s) * 1e9);
     const std::int64_t key = step_ns > 0 ? floor_div(t_ns, step_ns) : t_ns;
     if (key != last_key) {
       last_key = key;
@@ -153,24 +154,36 @@ Expected<DeskewStats, DeskewError> level_impl(std::span<const P> points, Stamp b
     target.origin = p_ref->p;
   }
   target.l = Eigen::AngleAxisd(-horizontal_yaw_rad(q_ref->q), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  out.reserve(out.size() + points.size());
-  return run(
-      points, base, track, target, use_positions, lidar_r, lidar_t, step_ns,
-      [&out](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
-        out.push_back(SourcedPoint{static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z()),
-                                   m.intensity, m.time_s, m.channel, m.source, flags});
-      });
+  // Room for every point, written by index and trimmed after: a push_back per point (not inlined) cost more than
+  // initialising the room.
+  const std::size_t first = out.size();
+  out.resize(first + points.size());
+  SourcedPoint* const dst = out.data() + first;
+  std::size_t n = 0;
+  const DeskewStats stats = run(points, base, track, target, use_positions, lidar_r, lidar_t, step_ns,
+                                [dst, &n](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
+                                  dst[n++] = SourcedPoint{static_cast<float>(v.x()), static_cast<float>(v.y()),
+                                                          static_cast<float>(v.z()), m.intensity, m.time_s,
+                                                          m.channel, m.source, flags};
+                                });
+  out.resize(first + n);
+  return stats;
 }
 
 template <typename P>
 DeskewStats plane_impl(std::span<const P> points, Stamp base, const PoseTrack& track, bool use_positions,
                        const Eigen::Matrix3d& lidar_r, const Eigen::Vector3d& lidar_t, std::int64_t step_ns,
                        std::vector<PlanePoint>& out) {
-  out.reserve(out.size() + points.size());
-  return run(points, base, track, Target{}, use_positions, lidar_r, lidar_t, step_ns,
-             [&out](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
-               out.push_back(PlanePoint{v, m.intensity, m.time_s, m.channel, m.source, flags});
-             });
+  const std::size_t first = out.size();  // as level_impl: room written by index, trimmed after
+  out.resize(first + points.size());
+  PlanePoint* const dst = out.data() + first;
+  std::size_t n = 0;
+  const DeskewStats stats = run(points, base, track, Target{}, use_positions, lidar_r, lidar_t, step_ns,
+                                [dst, &n](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
+                                  dst[n++] = PlanePoint{v, m.intensity, m.time_s, m.channel, m.source, flags};
+                                });
+  out.resize(first + n);
+  return stats;
 }
 
 }  // namespace
