@@ -28,25 +28,36 @@ namespace {
   return true;
 }();
 
-void* allocate(std::size_t n) {
+// Counts the allocation, then tries `get` until it gives memory, calling the new-handler between tries as the
+// standard operator new does; std::bad_alloc without one.
+template <typename Get>
+void* allocate_with(Get get) {
   fieldguard::alloc::note_allocation();
   for (;;) {
-    if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+    if (void* p = get()) return p;
     const std::new_handler h = std::get_new_handler();
     if (h == nullptr) throw std::bad_alloc();
     h();
   }
 }
 
+void* allocate(std::size_t n) {
+  return allocate_with([n] { return std::malloc(n == 0 ? 1 : n); });
+}
+
 void* allocate_aligned(std::size_t n, std::align_val_t al) {
-  fieldguard::alloc::note_allocation();
   const auto a = static_cast<std::size_t>(al);
   const std::size_t size = ((n == 0 ? 1 : n) + a - 1) / a * a;  // aligned_alloc wants a multiple of the alignment
-  for (;;) {
-    if (void* p = std::aligned_alloc(a, size)) return p;
-    const std::new_handler h = std::get_new_handler();
-    if (h == nullptr) throw std::bad_alloc();
-    h();
+  return allocate_with([a, size] { return std::aligned_alloc(a, size); });
+}
+
+// The nothrow forms: nullptr where the throwing form throws.
+template <typename Allocate>
+void* or_null(Allocate allocate_or_throw) noexcept {
+  try {
+    return allocate_or_throw();
+  } catch (...) {
+    return nullptr;
   }
 }
 
@@ -55,34 +66,18 @@ void* allocate_aligned(std::size_t n, std::align_val_t al) {
 void* operator new(std::size_t n) { return allocate(n); }
 void* operator new[](std::size_t n) { return allocate(n); }
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return allocate(n);
-  } catch (...) {
-    return nullptr;
-  }
+  return or_null([n] { return allocate(n); });
 }
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return allocate(n);
-  } catch (...) {
-    return nullptr;
-  }
+  return or_null([n] { return allocate(n); });
 }
 void* operator new(std::size_t n, std::align_val_t al) { return allocate_aligned(n, al); }
 void* operator new[](std::size_t n, std::align_val_t al) { return allocate_aligned(n, al); }
 void* operator new(std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept {
-  try {
-    return allocate_aligned(n, al);
-  } catch (...) {
-    return nullptr;
-  }
+  return or_null([n, al] { return allocate_aligned(n, al); });
 }
 void* operator new[](std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept {
-  try {
-    return allocate_aligned(n, al);
-  } catch (...) {
-    return nullptr;
-  }
+  return or_null([n, al] { return allocate_aligned(n, al); });
 }
 
 void operator delete(void* p) noexcept { std::free(p); }

@@ -44,7 +44,7 @@ Session::Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink,
       fusion_(cfg_, FusionInputs::enabled_in(cfg_)),
       detectors_(cfg_, static_cast<std::size_t>(cfg_.pipeline.workers)),
       pool_(pool_params(cfg_, io, waker_), [this](FrameJob& j, DetectedFrame& d) { process(j, d); }),
-      submitted_(pool_.params().queue_capacity + pool_.params().workers + pool_.params().reorder_slack + 1) {
+      submitted_(pool_.slots()) {
   waker_->session = this;
 }
 

@@ -82,23 +82,27 @@ DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
 }
 
 void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
-  if (!job.synced) {
+  const bool rotation = !job.synced;
+  if (rotation) {
     // The rotation trades places with the earlier result's frame, whose buffer the job takes back to the producer.
     std::swap(d.frame, job.rotation);
     d.fusion.reset();
-    if (!detect) {
-      d.result = perception::FrameResult{};
-      return;
-    }
-    try {
-      pipeline_.process(d.frame.points, d.result);
-    } catch (...) {
-      std::swap(d.frame, job.rotation);  // the job is still the rotation that failed, for the report
-      throw;
-    }
+  } else {
+    compensate(*job.synced, d);
+  }
+  if (!detect) {
+    d.result = perception::FrameResult{};
     return;
   }
-  const sync::SyncedFrame& sf = *job.synced;
+  try {
+    pipeline_.process(d.frame.points, d.result);
+  } catch (...) {
+    if (rotation) std::swap(d.frame, job.rotation);  // the job is still the rotation that failed, for the report
+    throw;
+  }
+}
+
+void FrameDetector::compensate(const sync::SyncedFrame& sf, DetectedFrame& d) {
   compensator_.compensate(sf, scratch_);
   d.frame.index = sf.seq;
   d.frame.sensor_stamp = sf.window_start;
@@ -116,11 +120,6 @@ void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
                         .timed_out = sf.timed_out,
                         .rotations = sf.rotations,
                         .scan_points = static_cast<std::uint32_t>(scratch_.stats.scan.points_out)};
-  if (detect) {
-    pipeline_.process(d.frame.points, d.result);
-  } else {
-    d.result = perception::FrameResult{};
-  }
 }
 
 DetectorSet::DetectorSet(const Config& cfg, std::size_t n) {

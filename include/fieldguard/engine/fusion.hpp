@@ -102,6 +102,7 @@ class FrameDetector {
   [[nodiscard]] const perception::Pipeline& pipeline() const { return pipeline_; }
 
  private:
+  void compensate(const sync::SyncedFrame& sf, DetectedFrame& d);  // into d.frame and d.fusion
   perception::Pipeline pipeline_;
   geo::FrameCompensator compensator_;
   geo::CompensatedFrame scratch_;

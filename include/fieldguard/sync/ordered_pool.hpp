@@ -191,6 +191,8 @@ class OrderedPool {
     return c;
   }
   [[nodiscard]] const PoolParams& params() const { return params_; }
+  // Slots: a bound on the tickets outstanding at any time (submitted and not yet delivered).
+  [[nodiscard]] std::size_t slots() const { return slots_.size(); }
   // What the system refused of PoolParams::worker, on the first worker that was refused anything; empty when
   // every worker that has started got its settings. Any thread.
   [[nodiscard]] std::string thread_refusal() const {
