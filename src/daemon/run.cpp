@@ -102,6 +102,10 @@ class Daemon {
 };
 
 bool Daemon::open() {
+  // Before any thread or buffer: the buffers a sensor outage makes the daemon hold go back afterwards.
+  if (std::string refused = sync::give_large_blocks_back(); !refused.empty() && sync::kGlibcMalloc) {
+    log_->warn("memory: large blocks may stay resident after they are freed ({})", refused);
+  }
   auto loaded = load_config_file(opt_.config);
   if (!loaded.ok()) {
     for (const auto& issue : loaded.issues) std::fprintf(stderr, "%s\n", issue.to_string().c_str());

@@ -5,7 +5,12 @@
 #include <sys/mman.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstring>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace fieldguard::sync {
 namespace {
@@ -64,6 +69,21 @@ std::string apply_to_this_thread(const ThreadSettings& s) {
 std::string lock_all_memory() {
   if (::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) return {};
   return std::string("mlockall: ") + std::strerror(errno);
+}
+
+std::string give_large_blocks_back(std::size_t threshold_bytes) {
+#if defined(__GLIBC__)
+  if (!kGlibcMalloc) return "a sanitizer's allocator: its own rules for giving memory back";
+  if (threshold_bytes > static_cast<std::size_t>(INT_MAX)) return "large-block threshold beyond the allocator's range";
+  const int t = static_cast<int>(threshold_bytes);
+  // Setting either one by hand ends glibc's adjustment of both; the trim threshold hands back the heap's free
+  // top too.
+  if (::mallopt(M_MMAP_THRESHOLD, t) == 1 && ::mallopt(M_TRIM_THRESHOLD, t) == 1) return {};
+  return "mallopt refused the large-block threshold";
+#else
+  (void)threshold_bytes;
+  return "not glibc's allocator: its own rules for giving memory back";
+#endif
 }
 
 std::string describe(const ThreadSettings& s) {

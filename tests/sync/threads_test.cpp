@@ -6,8 +6,13 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include <cstdlib>
 #include <string>
 #include <thread>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace fieldguard::sync {
 namespace {
@@ -53,6 +58,30 @@ TEST(Threads, Describe) {
   EXPECT_EQ(describe({"", SchedPolicy::Fifo, 50, {}}), "fifo 50");
   EXPECT_EQ(describe({"", SchedPolicy::RoundRobin, 7, {}}), "rr 7");
   EXPECT_EQ(describe({}), "other");
+}
+
+// A large block freed goes back to the system, and so does the next one, smaller: without the fixed threshold
+// glibc raises it to the 4 MiB block freed first, and the 1 MiB block after it comes from the heap.
+TEST(Threads, LargeBlocksAreGivenBackWhateverWasFreedBefore) {
+#if defined(__GLIBC__)
+  if (!kGlibcMalloc) GTEST_SKIP() << "a sanitizer's allocator: mallopt and mallinfo2 say nothing of it";
+  ASSERT_EQ(give_large_blocks_back(), "");
+  const auto mapped = [] { return mallinfo2().hblks; };
+  const auto touch = [](void* p) { asm volatile("" : : "g"(p) : "memory"); };  // the blocks must exist
+  const std::size_t before = mapped();
+  void* big = std::malloc(std::size_t{4} << 20);
+  touch(big);
+  EXPECT_EQ(mapped(), before + 1);
+  std::free(big);
+  EXPECT_EQ(mapped(), before);
+  void* smaller = std::malloc(std::size_t{1} << 20);
+  touch(smaller);
+  EXPECT_EQ(mapped(), before + 1) << "the 1 MiB block came from the heap: it would stay resident once freed";
+  std::free(smaller);
+  EXPECT_EQ(mapped(), before);
+#else
+  GTEST_SKIP() << "not glibc";
+#endif
 }
 
 }  // namespace
