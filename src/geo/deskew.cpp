@@ -85,7 +85,10 @@ DeskewStats run(std::span<const P> points, Stamp base, const PoseTrack& track, c
                 const Eigen::Matrix3d& lidar_r, const Eigen::Vector3d& lidar_t, std::int64_t step_ns, Emit&& emit) {
   DeskewStats stats;
   stats.points_in = points.size();
-  std::int64_t last_key = std::numeric_limits<std::int64_t>::min();
+  // The current step's times [step_lo, step_hi): a point inside it shares the pose without a division.
+  std::int64_t step_lo = 0;
+  std::int64_t step_hi = 0;
+  bool have_step = false;
   Xf xf{};
   bool have_xf = false;
   TrackError last_error = TrackError::Empty;
@@ -96,10 +99,12 @@ DeskewStats run(std::span<const P> points, Stamp base, const PoseTrack& track, c
       continue;
     }
     const std::int64_t t_ns = base.ns + round_half_away(static_cast<double>(m.time_s) * 1e9);
-    const std::int64_t key = step_ns > 0 ? floor_div(t_ns, step_ns) : t_ns;
-    if (key != last_key) {
-      last_key = key;
-      const Stamp at{step_ns > 0 ? key * step_ns + step_ns / 2 : t_ns};
+    const bool same_step = have_step && (step_ns > 0 ? t_ns >= step_lo && t_ns < step_hi : t_ns == step_lo);
+    if (!same_step) {
+      step_lo = step_ns > 0 ? floor_div(t_ns, step_ns) * step_ns : t_ns;
+      step_hi = step_lo + step_ns;
+      have_step = true;
+      const Stamp at{step_ns > 0 ? step_lo + step_ns / 2 : t_ns};
       have_xf = false;
       auto q = track.attitude_at(at);
       if (!q) {
@@ -131,20 +136,23 @@ DeskewStats run(std::span<const P> points, Stamp base, const PoseTrack& track, c
       count(stats, last_error);
       continue;
     }
-    const Eigen::Vector3d v =
-        xf.r * Eigen::Vector3d(static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)) + xf.t;
-    emit(v, m, xf.extrapolated ? kExtrapolatedPose : std::uint8_t{0});
+    // Written out: Eigen's product here was a call per point.
+    const double px = p.x;
+    const double py = p.y;
+    const double pz = p.z;
+    const Eigen::Matrix3d& r = xf.r;
+    const Eigen::Vector3d v(r(0, 0) * px + r(0, 1) * py + r(0, 2) * pz + xf.t.x(),
+                            r(1, 0) * px + r(1, 1) * py + r(1, 2) * pz + xf.t.y(),
+                            r(2, 0) * px + r(2, 1) * py + r(2, 2) * pz + xf.t.z());
+    emit(v, p, m, xf.extrapolated ? kExtrapolatedPose : std::uint8_t{0});
     ++stats.points_out;
     if (xf.extrapolated) ++stats.extrapolated;
   }
   return stats;
 }
 
-template <typename P>
-Expected<DeskewStats, DeskewError> level_impl(std::span<const P> points, Stamp base, const PoseTrack& track,
-                                              Stamp t_ref, bool use_positions, const Eigen::Matrix3d& lidar_r,
-                                              const Eigen::Vector3d& lidar_t, std::int64_t step_ns,
-                                              std::vector<SourcedPoint>& out) {
+// The level frame of t_ref: yaw about the vertical and the reference position (with positions).
+Expected<Target, DeskewError> level_target(const PoseTrack& track, Stamp t_ref, bool use_positions) {
   Target target;
   auto q_ref = track.attitude_at(t_ref);
   if (!q_ref) return Unexpected{DeskewError::NoReferencePose};
@@ -154,17 +162,32 @@ Expected<DeskewStats, DeskewError> level_impl(std::span<const P> points, Stamp b
     target.origin = p_ref->p;
   }
   target.l = Eigen::AngleAxisd(-horizontal_yaw_rad(q_ref->q), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return target;
+}
+
+template <typename P>
+Expected<DeskewStats, DeskewError> level_impl(std::span<const P> points, Stamp base, const PoseTrack& track,
+                                              Stamp t_ref, bool use_positions, const Eigen::Matrix3d& lidar_r,
+                                              const Eigen::Vector3d& lidar_t, std::int64_t step_ns,
+                                              std::vector<SourcedPoint>& out) {
+  const auto target = level_target(track, t_ref, use_positions);
+  if (!target) return Unexpected{target.error()};
   // Room for every point, written by index and trimmed after: a push_back per point (not inlined) cost more than
   // initialising the room.
   const std::size_t first = out.size();
   out.resize(first + points.size());
   SourcedPoint* const dst = out.data() + first;
   std::size_t n = 0;
-  const DeskewStats stats = run(points, base, track, target, use_positions, lidar_r, lidar_t, step_ns,
-                                [dst, &n](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
-                                  dst[n++] = SourcedPoint{static_cast<float>(v.x()), static_cast<float>(v.y()),
-                                                          static_cast<float>(v.z()), m.intensity, m.time_s,
-                                                          m.channel, m.source, flags};
+  const DeskewStats stats = run(points, base, track, *target, use_positions, lidar_r, lidar_t, step_ns,
+                                [dst, &n](const Eigen::Vector3d& v, const P&, const Meta& m, std::uint8_t flags) {
+                                  dst[n++] = SourcedPoint{static_cast<float>(v.x()),
+                                                          static_cast<float>(v.y()),
+                                                          static_cast<float>(v.z()),
+                                                          m.intensity,
+                                                          m.time_s,
+                                                          m.channel,
+                                                          m.source,
+                                                          flags};
                                 });
   out.resize(first + n);
   return stats;
@@ -179,7 +202,7 @@ DeskewStats plane_impl(std::span<const P> points, Stamp base, const PoseTrack& t
   PlanePoint* const dst = out.data() + first;
   std::size_t n = 0;
   const DeskewStats stats = run(points, base, track, Target{}, use_positions, lidar_r, lidar_t, step_ns,
-                                [dst, &n](const Eigen::Vector3d& v, const Meta& m, std::uint8_t flags) {
+                                [dst, &n](const Eigen::Vector3d& v, const P&, const Meta& m, std::uint8_t flags) {
                                   dst[n++] = PlanePoint{v, m.intensity, m.time_s, m.channel, m.source, flags};
                                 });
   out.resize(first + n);
@@ -192,6 +215,33 @@ Expected<DeskewStats, DeskewError> Deskewer::to_level(std::span<const LidarPoint
                                                       const PoseTrack& track, Stamp t_ref,
                                                       std::vector<SourcedPoint>& out) const {
   return level_impl(points, base, track, t_ref, params_.use_positions, lidar_r_, lidar_t_, step_ns_, out);
+}
+
+Expected<DeskewStats, DeskewError> Deskewer::to_detection(std::span<const LidarPoint> points, Stamp base,
+                                                          const PoseTrack& track, Stamp t_ref,
+                                                          const Eigen::Vector3f& offset,
+                                                          std::span<LidarPoint> room) const {
+  if (room.size() < points.size()) throw std::invalid_argument("Deskewer::to_detection: room for fewer points");
+  const auto target = level_target(track, t_ref, params_.use_positions);
+  if (!target) return Unexpected{target.error()};
+  LidarPoint* const dst = room.data();
+  std::size_t n = 0;
+  // The same float steps as to_level() then the offset taken off, so either way gives the same bits.
+  return run(points, base, track, *target, params_.use_positions, lidar_r_, lidar_t_, step_ns_,
+             [dst, &n, &offset](const Eigen::Vector3d& v, const LidarPoint& in, const Meta&, std::uint8_t) {
+               LidarPoint& p = dst[n++];
+               p.x = static_cast<float>(v.x()) - offset.x();
+               p.y = static_cast<float>(v.y()) - offset.y();
+               p.z = static_cast<float>(v.z()) - offset.z();
+               p.intensity = in.intensity;
+               p.time_s = in.time_s;
+               p.range_m = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+               p.azimuth_cdeg = in.azimuth_cdeg;
+               p.ring = in.ring;
+               p.return_type = in.return_type;
+               p.source = static_cast<std::uint8_t>(PointSource::Lidar3d);
+               p.reserved1 = 0;
+             });
 }
 
 Expected<DeskewStats, DeskewError> Deskewer::to_level(std::span<const SourcedPoint> points, Stamp base,

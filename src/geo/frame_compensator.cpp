@@ -161,7 +161,8 @@ FrameCompensator::FrameCompensator(const CompensationParams& params)
 void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFrame& out) const {
   out.levelling = Levelling::None;
   out.t_ref = frame.window_end;
-  out.points.clear();
+  // out.points is not cleared: it is sized once below, and the room a reused frame already has is written over
+  // rather than initialised again.
   out.plane.clear();
   out.reference.reset();
   out.attitude.reset();
@@ -269,49 +270,35 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
   level.clear();
   std::span<const LidarPoint> points3d(frame.points);
   std::span<const SourcedPoint> points2d(lifted);
+  // Room for every point, written by index and trimmed after (a push_back per point cost more than initialising
+  // the room). The 3D points go straight from the sensor into detection points, in one pass.
+  out.points.resize(frame.points.size() + lifted.size());
+  const std::span<LidarPoint> room(out.points);
   const Deskewer* used = nullptr;
   if (track.position_count() > 0) {
-    level.reserve(frame.points.size() + lifted.size());
-    if (auto s = deskew_full_.to_level(points3d, frame.window_start, track, out.t_ref, level)) {
+    if (auto s = deskew_full_.to_detection(points3d, frame.window_start, track, out.t_ref, t_lidar, room)) {
       st.lidar = *s;
       used = &deskew_full_;
       out.levelling = Levelling::Full;
     }
   }
   if (used == nullptr && track.attitude_count() > 0) {
-    level.reserve(frame.points.size() + lifted.size());
-    if (auto s = deskew_attitude_only_.to_level(points3d, frame.window_start, track, out.t_ref, level)) {
+    if (auto s = deskew_attitude_only_.to_detection(points3d, frame.window_start, track, out.t_ref, t_lidar, room)) {
       st.lidar = *s;
       used = &deskew_attitude_only_;
       out.levelling = Levelling::AttitudeOnly;
     }
   }
 
-  // Room for every point, written by index and trimmed after (a push_back per point cost more than initialising
-  // the room).
-  out.points.resize(frame.points.size() + lifted.size());
   LidarPoint* const dst = out.points.data();
   std::size_t written = 0;
   if (used != nullptr) {
-    const std::size_t n3 = level.size();
+    written = st.lidar.points_out;
+    level.reserve(lifted.size());
     if (auto s = used->to_level(points2d, frame.window_start, track, out.t_ref, level)) st.scan = *s;
-    // Deskew keeps the input order and drops a point only for a non-finite value or for its time (equal
-    // times share a pose), so walking both lists in step pairs each output with its input point.
-    std::size_t j = 0;
-    for (const LidarPoint& in : frame.points) {
-      if (j >= n3) break;
-      if (!finite_point(in)) continue;
-      const SourcedPoint& s = level[j];
-      if (s.time_s != in.time_s || s.channel != in.ring) continue;
+    for (const SourcedPoint& s : level) {
       LidarPoint p = detection_point(s, t_lidar);
-      p.azimuth_cdeg = in.azimuth_cdeg;
-      p.return_type = in.return_type;
-      dst[written++] = p;
-      ++j;
-    }
-    for (std::size_t k = n3; k < level.size(); ++k) {
-      LidarPoint p = detection_point(level[k], t_lidar);
-      const double angle = scip::step_angle_rad(static_cast<double>(level[k].channel), params_.scan_geometry);
+      const double angle = scip::step_angle_rad(static_cast<double>(s.channel), params_.scan_geometry);
       p.azimuth_cdeg = azimuth_cdeg_of(angle);
       dst[written++] = p;
     }

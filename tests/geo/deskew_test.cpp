@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "fieldguard/geo/attitude.hpp"
@@ -363,6 +364,58 @@ TEST(Deskew, KeepsSourceAndChannelOfMergedPoints) {
   // the vehicle was at the reference time.
   EXPECT_NEAR(static_cast<double>(out[0].x), 2.1, 1e-5);
   EXPECT_NEAR(static_cast<double>(out[0].y), 0.0, 1e-5);
+}
+
+// The one-pass path for detection: each output is its own input point moved (to_level's values less the offset,
+// to the bit), with the input's azimuth, ring and return type, whatever points before it were dropped.
+TEST(Deskew, DetectionPointsKeepTheirOwnInputsFields) {
+  PoseTrack track;
+  for (int i = 0; i <= 10; ++i) ASSERT_TRUE(track.add_attitude(at_s(0.01 * i), quaternion_of({2.0, -3.0, 30.0})));
+  ASSERT_TRUE(track.add_position(at_s(0.0), Eigen::Vector3d(100.0, 200.0, 0.0)));
+  ASSERT_TRUE(track.add_position(at_s(0.1), Eigen::Vector3d(100.0, 201.0, 0.0)));
+  std::vector<LidarPoint> pts(6);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    pts[i].x = 3.0F + static_cast<float>(i);
+    pts[i].y = -1.0F;
+    pts[i].z = 0.5F;
+    pts[i].time_s = 0.01F * static_cast<float>(i + 1);
+    pts[i].ring = 7;  // the same ring and time for the dropped point and the next: no pairing by them
+    pts[i].azimuth_cdeg = static_cast<std::uint16_t>(100 * i);
+    pts[i].return_type = i % 2 == 0 ? ReturnType::Strongest : ReturnType::Last;
+    pts[i].intensity = static_cast<float>(10 * i);
+  }
+  pts[2].x = std::numeric_limits<float>::quiet_NaN();
+  pts[3].time_s = pts[2].time_s;
+  pts[5].time_s = 0.5F;  // after the end
+  const Deskewer deskew(DeskewParams{});
+  const Eigen::Vector3f offset(0.5F, -0.25F, 2.0F);
+  std::vector<LidarPoint> room(pts.size());
+  const auto s = deskew.to_detection(pts, at_s(0.0), track, at_s(0.1), offset, room);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->points_out, 4U);
+  EXPECT_EQ(s->dropped_not_finite, 1U);
+  EXPECT_EQ(s->dropped_after_end, 1U);
+  std::vector<SourcedPoint> level;
+  ASSERT_TRUE(deskew.to_level(pts, at_s(0.0), track, at_s(0.1), level).has_value());
+  ASSERT_EQ(level.size(), 4U);
+  const std::size_t kept[] = {0, 1, 3, 4};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const LidarPoint& in = pts[kept[k]];
+    const LidarPoint& out = room[k];
+    EXPECT_EQ(out.x, level[k].x - offset.x());
+    EXPECT_EQ(out.y, level[k].y - offset.y());
+    EXPECT_EQ(out.z, level[k].z - offset.z());
+    EXPECT_EQ(out.range_m, std::sqrt(out.x * out.x + out.y * out.y + out.z * out.z));
+    EXPECT_EQ(out.azimuth_cdeg, in.azimuth_cdeg) << k;
+    EXPECT_EQ(out.return_type, in.return_type) << k;
+    EXPECT_EQ(out.intensity, in.intensity);
+    EXPECT_EQ(out.time_s, in.time_s);
+    EXPECT_EQ(out.ring, 7);
+    EXPECT_EQ(out.source, static_cast<std::uint8_t>(PointSource::Lidar3d));
+  }
+  std::vector<LidarPoint> small(2);
+  EXPECT_THROW((void)deskew.to_detection(pts, at_s(0.0), track, at_s(0.1), offset, small), std::invalid_argument);
+  EXPECT_EQ(deskew.to_detection(pts, at_s(0.0), track, at_s(3.0), offset, room).error(), DeskewError::NoReferencePose);
 }
 
 TEST(Deskew, InvalidParameters) {

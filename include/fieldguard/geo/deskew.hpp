@@ -81,6 +81,13 @@ class Deskewer {
   [[nodiscard]] Expected<DeskewStats, DeskewError> to_level(std::span<const SourcedPoint> points, Stamp base,
                                                             const PoseTrack& track, Stamp t_ref,
                                                             std::vector<SourcedPoint>& out) const;
+  // 3D points straight into detection points (FrameCompensator's one pass): the level frame of t_ref less
+  // `offset` (the LiDAR's position, so that range_m is measured from it), range_m recomputed, azimuth, ring,
+  // return type and intensity kept, source Lidar3d. Writes room[0, points_out); room holds points.size().
+  [[nodiscard]] Expected<DeskewStats, DeskewError> to_detection(std::span<const LidarPoint> points, Stamp base,
+                                                                const PoseTrack& track, Stamp t_ref,
+                                                                const Eigen::Vector3f& offset,
+                                                                std::span<LidarPoint> room) const;
   [[nodiscard]] DeskewStats to_plane(std::span<const LidarPoint> points, Stamp base, const PoseTrack& track,
                                      std::vector<PlanePoint>& out) const;
   [[nodiscard]] DeskewStats to_plane(std::span<const SourcedPoint> points, Stamp base, const PoseTrack& track,

@@ -116,7 +116,7 @@ struct CompensationWork {
   std::vector<Fix> fixes;
   std::vector<AttSample> atts;
   std::vector<SourcedPoint> lifted;  // the 2D scan in the 3D LiDAR's frame
-  std::vector<SourcedPoint> level;   // deskewed and levelled, before they become detection points
+  std::vector<SourcedPoint> level;   // the 2D scan deskewed and levelled, before it becomes detection points
   std::optional<PoseTrack> track;
   const void* track_owner = nullptr;  // the compensator whose TrackParams built `track`
 };
