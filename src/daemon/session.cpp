@@ -256,6 +256,16 @@ void Session::print_summary() const {
       "packet to stop request); %llu late (over %.1f ms)\n",
       ms(latency_.quantile_ns(0.5)), ms(latency_.quantile_ns(0.99)), ms(latency_.max_ns()), u(latency_.count()),
       u(late_), cfg_.realtime.latency_budget_ms);
+  if (parts_[0].count() > 0) {
+    std::string line = "  latency parts    ";
+    for (std::size_t i = 0; i < parts_.size(); ++i) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s %s %.3f, %.3f", i == 0 ? "" : ";", kLatencyParts[i],
+                    ms(parts_[i].quantile_ns(0.5)), ms(parts_[i].quantile_ns(0.99)));
+      line += buf;
+    }
+    std::printf("%s (median, p99 ms)\n", line.c_str());
+  }
   std::printf("  io loop           longest gap %.3f ms (a due timer waited that long for the io thread)\n",
               ms(io_gap_.max_ns()));
   if (alloc::enabled()) {
@@ -343,7 +353,11 @@ void Session::submit_jobs() {
 
 void Session::deliver(const Pool::Result& r) {
   const alloc::Scope frame_path(alloc::Path::Frame);
-  if (!submitted_.empty()) submitted_.pop_front();
+  Stamp submitted;  // results come in submit order
+  if (!submitted_.empty()) {
+    submitted = submitted_.front();
+    submitted_.pop_front();
+  }
   // Stopping: what the workers finish now must not follow the last STOP onto the bus.
   if (stopped_) return;
   if (r.outcome != sync::Outcome::Processed || r.output == nullptr) {
@@ -371,8 +385,14 @@ void Session::deliver(const Pool::Result& r) {
   // From the kernel's receive time of the frame's last 3D LiDAR packet to the write of its stop request (just done):
   // decoding, any wait of the synchronizer for another sensor, the hand-off to a worker, compensation, detection,
   // the hand-back and the safety monitor.
-  const std::int64_t latency_ns = wall_clock_now().ns - r.input->last_packet.ns;
+  const Stamp written = wall_clock_now();
+  const std::int64_t latency_ns = written.ns - r.input->last_packet.ns;
   latency_.add(latency_ns);
+  if (submitted.ns != 0) {  // its parts, in kLatencyParts' order
+    const Stamp at[] = {r.input->last_packet,  r.input->complete,  submitted, r.output->started,
+                        r.output->compensated, r.output->finished, written};
+    for (std::size_t i = 0; i < parts_.size(); ++i) parts_[i].add(at[i + 1].ns - at[i].ns);
+  }
   if (static_cast<double>(latency_ns) * 1e-6 > cfg_.realtime.latency_budget_ms && late_++ == 0) {
     log_->warn(
         "frame decided {:.3f} ms after its last LiDAR packet, over realtime.latency_budget_ms {} (counted; this "

@@ -3,11 +3,13 @@
 // and its output stage, all on one io_context. A reload replaces the whole session; the CAN sink outlives it.
 // Thread contract: everything here runs on the io thread, but process(), which the pool's workers call.
 
+#include <array>
 #include <atomic>
 #include <boost/asio/io_context.hpp>
 #include <boost/circular_buffer.hpp>
 #include <chrono>
 #include <cstdint>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,6 +30,13 @@
 #include "fieldguard/sync/ordered_pool.hpp"
 
 namespace fieldguard::app {
+
+// A frame's latency in its parts, each from the end of the one before: from its last LiDAR packet until the
+// frame was whole (the synchronizer waiting for another sensor, and decoding), until the io thread handed it
+// to the pool (assembly), until a worker took it up, compensation, detection, and back on the io thread to the
+// write of its stop request (the safety monitor and the CAN frames).
+inline constexpr const char* kLatencyParts[] = {"waiting for sensors", "io thread", "to a worker",
+                                                "compensation",        "detection", "decision"};
 
 class Session {
   using Pool = sync::OrderedPool<FrameJob, DetectedFrame>;
@@ -122,8 +131,10 @@ class Session {
   std::uint64_t bad_length_ = 0;
   bool heard_all_ = false;
   bool stalled_ = false;
-  LatencyStats latency_;    // per frame: last packet's kernel receive time to its stop request's write
-  LatencyStats io_gap_;     // per tick: how late the output timer ran
+  LatencyStats latency_;  // per frame: last packet's kernel receive time to its stop request's write
+  LatencyStats io_gap_;   // per tick: how late the output timer ran
+  // latency_ in its parts, per frame, named by kLatencyParts.
+  std::array<LatencyStats, std::size(kLatencyParts)> parts_;
   std::uint64_t late_ = 0;  // frames over realtime.latency_budget_ms
   bool worker_refusal_logged_ = false;
   // Allocations counted (core/alloc_count.hpp) when the kWarmFrames-th frame was decided: the summary's are those

@@ -82,6 +82,7 @@ DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
 }
 
 void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
+  d.started = wall_clock_now();
   const bool rotation = !job.synced;
   if (rotation) {
     // The rotation trades places with the earlier result's frame, whose buffer the job takes back to the producer.
@@ -90,8 +91,10 @@ void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
   } else {
     compensate(*job.synced, d);
   }
+  d.compensated = wall_clock_now();
   if (!detect) {
     d.result = perception::FrameResult{};
+    d.finished = d.compensated;
     return;
   }
   try {
@@ -100,6 +103,7 @@ void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
     if (rotation) std::swap(d.frame, job.rotation);  // the job is still the rotation that failed, for the report
     throw;
   }
+  d.finished = wall_clock_now();
 }
 
 void FrameDetector::compensate(const sync::SyncedFrame& sf, DetectedFrame& d) {

@@ -362,6 +362,19 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     const std::string alloc_line = out.substr(al + 2, out.find('\n', al) - al - 2);
     EXPECT_NE(alloc_line.find("sensor samples "), std::string::npos) << alloc_line;
     std::printf("[ measured ] %s\n", alloc_line.c_str());
+    // The latency in its parts, each named, detection's above zero.
+    const std::string parts = "  latency parts     ";
+    const auto lp = out.find(parts);
+    ASSERT_NE(lp, std::string::npos) << out;
+    const std::string parts_line = out.substr(lp + 2, out.find('\n', lp) - lp - 2);
+    for (const char* name :
+         {"waiting for sensors ", "io thread ", "to a worker ", "compensation ", "detection ", "decision "}) {
+      EXPECT_NE(parts_line.find(name), std::string::npos) << parts_line;
+    }
+    const auto det = parts_line.find("detection ");
+    ASSERT_NE(det, std::string::npos) << parts_line;
+    EXPECT_GT(std::stod(parts_line.substr(det + 10)), 0.0) << parts_line;
+    std::printf("[ measured ] %s\n", parts_line.c_str());
     // The hold is on in fieldguard.yaml: the daemon runs it, in frame order, and counts what it held.
     const std::string held = "  held obstacles    ";
     const auto h = out.find(held);

@@ -88,6 +88,11 @@ struct DetectedFrame {
   LidarFrame frame;
   perception::FrameResult result;
   std::optional<FusionInfo> fusion;  // fused mode
+  // Wall-clock times on the worker, the worker's share of the frame's latency: taken up, compensated (= started
+  // for a rotation), detected.
+  Stamp started;
+  Stamp compensated;
+  Stamp finished;
 };
 
 class FrameDetector {
