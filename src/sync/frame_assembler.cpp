@@ -263,10 +263,19 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
     f.points.insert(f.points.end(), r.points.begin(), r.points.end());
     for (std::size_t k = at; k < f.points.size(); ++k) f.points[k].time_s += shift;
   }
+  // Room for a whole frame (and an eighth more, as rotations vary) in every buffer handed back: the rotation
+  // written into it next, when it starts a window, becomes that frame's buffer as it is, and only the window's
+  // later rotations are copied. One allocation per buffer while warming up; the same buffers after.
+  const std::size_t frame_room = n + n / 8;
   for (LidarRotation& r : w.rotations) {
-    // Not cleared: the rotation assembler writes over the points it holds (RotationAssembler::recycle()) instead
-    // of constructing them again.
-    if (r.points.capacity() > 0 && spare_points_.size() < kMaxSpare) spare_points_.push_back(std::move(r.points));
+    if (r.points.capacity() == 0 || spare_points_.size() >= kMaxSpare) continue;
+    if (w.rotations.size() > 1 && r.points.capacity() < frame_room) {
+      r.points.clear();  // nothing to keep: reserve() need not copy
+      r.points.reserve(frame_room);
+    }
+    // Otherwise not cleared: the rotation assembler writes over the points it holds (RotationAssembler::recycle())
+    // instead of constructing them again.
+    spare_points_.push_back(std::move(r.points));
   }
   w.rotations.clear();
   if (spare_lists_.size() < kMaxSpare) spare_lists_.push_back(std::move(w.rotations));

@@ -488,7 +488,9 @@ TEST(FrameAssembler, ALeadNeedsTwoRecentEpochs) {
 }
 
 // Frames handed back (recycle()) hold later frames, and the rotations copied into a frame come back for the
-// rotation assembler (take_spare_points()): once warm, a stream of two-rotation frames uses the same few buffers.
+// rotation assembler (take_spare_points()): once warm, a stream of two-rotation frames uses the same few buffers,
+// and each frame's buffer is its own first rotation's (only the second rotation copied), the buffers handed back
+// having room for a frame.
 TEST(FrameAssembler, RecycledFramesAndRotationBuffersAreReused) {
   Scenario sc;
   sc.with_scan = false;
@@ -498,7 +500,9 @@ TEST(FrameAssembler, RecycledFramesAndRotationBuffersAreReused) {
   std::vector<SyncedFrame> out;
   std::vector<std::vector<LidarPoint>> spare;  // what a rotation assembler would reuse
   std::vector<const LidarPoint*> frame_buffers;
+  std::vector<const LidarPoint*> rotation_buffers;  // as added, in order
   std::size_t frames = 0;
+  std::size_t own_buffer = 0;
   for (const Event& e : events(sc)) {
     switch (e.kind) {
       case 0: {
@@ -509,6 +513,7 @@ TEST(FrameAssembler, RecycledFramesAndRotationBuffersAreReused) {
           b.assign(r.points.begin(), r.points.end());
           r.points = std::move(b);
         }
+        rotation_buffers.push_back(r.points.data());
         fa.add_rotation(std::move(r));
         break;
       }
@@ -519,7 +524,11 @@ TEST(FrameAssembler, RecycledFramesAndRotationBuffersAreReused) {
     fa.poll(Stamp{e.rx}, out);
     for (SyncedFrame& f : out) {
       check_frame_points(f, sc.rotation_ns);
-      if (++frames > 3) frame_buffers.push_back(f.points.data());
+      if (++frames > 3) {
+        frame_buffers.push_back(f.points.data());
+        const auto recent = rotation_buffers.end() - std::min<std::ptrdiff_t>(3, std::ssize(rotation_buffers));
+        if (std::find(recent, rotation_buffers.end(), f.points.data()) != rotation_buffers.end()) ++own_buffer;
+      }
       fa.recycle(std::move(f));
     }
     out.clear();
@@ -530,6 +539,7 @@ TEST(FrameAssembler, RecycledFramesAndRotationBuffersAreReused) {
   std::sort(frame_buffers.begin(), frame_buffers.end());
   const auto distinct = std::unique(frame_buffers.begin(), frame_buffers.end()) - frame_buffers.begin();
   EXPECT_LE(distinct, 4) << "frames after the third in new buffers";
+  EXPECT_EQ(own_buffer, frame_buffers.size()) << "frames after the third copied their first rotation";
 }
 
 TEST(AssemblerParams, ALeadIsWithinTheBracketGap) {
