@@ -258,10 +258,16 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   for (std::size_t i = 1; i < w.rotations.size(); ++i) {
     const LidarRotation& r = w.rotations[i];
     const auto shift = static_cast<float>(static_cast<double>(r.start.ns - w.start.ns) * 1e-9);
-    // Copied as a block, then the times shifted: a point-by-point push_back was a tenth of the io thread's time.
+    // Room made once, then each point copied with its time shifted in the same pass (a point-by-point push_back
+    // was a tenth of the io thread's time; a block copy and a second pass for the times, 0.3-0.5 ms at frame close).
     const std::size_t at = f.points.size();
-    f.points.insert(f.points.end(), r.points.begin(), r.points.end());
-    for (std::size_t k = at; k < f.points.size(); ++k) f.points[k].time_s += shift;
+    f.points.resize(at + r.points.size());  // within the room reserved above: constructs, no allocation
+    LidarPoint* const dst = f.points.data() + at;
+    const LidarPoint* const src = r.points.data();
+    for (std::size_t k = 0; k < r.points.size(); ++k) {
+      dst[k] = src[k];
+      dst[k].time_s += shift;
+    }
   }
   // Room for a whole frame (and an eighth more, as rotations vary) in every buffer handed back: the rotation
   // written into it next, when it starts a window, becomes that frame's buffer as it is, and only the window's
