@@ -185,6 +185,13 @@ void Session::on_tick(std::chrono::nanoseconds late) {
   } else if (SteadyClock::now() - last_status_ >= kStatusEvery) {
     last_status_ = SteadyClock::now();
     notify_.status(status(now));
+    // With the status, and only between frames: the pool's slots a burst filled (frames released together after
+    // a sensor outage) give their buffers back; a steady stream reuses no more than one per worker.
+    trimmed_slots_ +=
+        pool_.trim_idle(static_cast<std::size_t>(cfg_.pipeline.workers), [](FrameJob& in, DetectedFrame& out) {
+          in = FrameJob{};
+          out = DetectedFrame{};
+        });
   }
   if (!stalled && ready_) notify_.progress(SteadyClock::now());
 }
@@ -235,8 +242,10 @@ void Session::print_summary() const {
   std::printf("  frames            %llu decided, %llu lost\n", u(c.frames), u(lost_));
   std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", u(c.stop_frames), u(c.go_frames), u(c.changes));
   if (cfg_.perception.hold.enabled) std::printf("  held obstacles    %llu (from fragments)\n", u(held_));
-  std::printf("  pool              %llu submitted, %llu dropped, %llu refused, %llu failed\n", u(pc.submitted),
-              u(pc.dropped), u(pc.refused), u(pc.failed));
+  std::printf(
+      "  pool              %llu submitted, %llu dropped, %llu refused, %llu failed; %llu slots gave their buffers back "
+      "after bursts\n",
+      u(pc.submitted), u(pc.dropped), u(pc.refused), u(pc.failed), u(trimmed_slots_));
   std::printf("  3d lidar          %llu packets, %llu decoded, %llu bad length, %llu full rotations, %llu partial\n",
               u(sc.packets), u(sc.decoded), u(bad_length_), u(sc.full_rotations), u(sc.partial_rotations));
   if (const sync::Synchronizer* sy = fusion_.synchronizer()) {

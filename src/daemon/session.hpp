@@ -144,6 +144,7 @@ class Session {
   std::uint64_t warm_frames_ = 0;  // frames decided when they were taken
   bool stopped_ = false;
   SteadyClock::time_point last_status_{};
+  std::uint64_t trimmed_slots_ = 0;  // pool slots whose buffers went back (OrderedPool::trim_idle)
 };
 
 }  // namespace fieldguard::app

@@ -404,6 +404,48 @@ TEST(OrderedPool, ProcessIntoReusesTheBuffersOfAFewSlots) {
   EXPECT_LE(inputs.size(), 2U) << "inputs handed back from other slots than the last";
 }
 
+// A burst fills many slots; once idle, trim_idle() empties all but the most recently used, and a steady stream after
+// it goes on in the kept slot's buffers (no new one). Nothing is trimmed while a ticket is outstanding.
+TEST(OrderedPool, TrimIdleEmptiesTheSlotsABurstFilled) {
+  PoolParams p;
+  p.workers = 2;
+  p.queue_capacity = 8;
+  OrderedPool<Item, std::vector<std::uint64_t>> pool(
+      p, [](Item& it, std::vector<std::uint64_t>& out) { out.assign(4096, digest(it)); });
+  std::vector<const void*> last_outputs;
+  const auto sink = [&](const auto& r) {
+    ASSERT_EQ(r.outcome, Outcome::Processed);
+    last_outputs.push_back(r.output->data());
+  };
+  const auto trim = [](Item& in, std::vector<std::uint64_t>& out) {
+    in = Item{};
+    out = std::vector<std::uint64_t>{};
+  };
+  Item in;
+  for (std::uint64_t seq = 0; seq < 8; ++seq) {  // the burst: 8 at once
+    in.seq = seq;
+    in.payload.assign(1024, static_cast<std::uint32_t>(seq));
+    ASSERT_TRUE(pool.submit(in));
+  }
+  EXPECT_EQ(pool.trim_idle(1, trim), 0U) << "trimmed with tickets outstanding";
+  while (pool.outstanding() > 0) pool.poll_wait(sink);
+  ASSERT_EQ(last_outputs.size(), 8U);
+  const std::size_t trimmed = pool.trim_idle(1, trim);
+  EXPECT_GE(trimmed, 6U);  // the burst used 7 or 8 slots (a worker may have finished one before the last submit)
+  EXPECT_LE(trimmed, 7U);
+  EXPECT_EQ(pool.trim_idle(1, trim), 0U) << "slots trimmed again without being used";
+  // Steady again, one at a time: every result in the kept slot's buffer, the last one of the burst.
+  const void* kept = last_outputs.back();
+  last_outputs.clear();
+  for (std::uint64_t seq = 8; seq < 20; ++seq) {
+    in.seq = seq;
+    ASSERT_TRUE(pool.submit(in));
+    while (pool.outstanding() > 0) pool.poll_wait(sink);
+  }
+  for (const void* o : last_outputs) EXPECT_EQ(o, kept);
+  pool.stop(Drain::Yes);
+}
+
 TEST(OrderedPool, RejectsBadParameters) {
   const auto f = [](Item& it) { return it.seq; };
   PoolParams p;

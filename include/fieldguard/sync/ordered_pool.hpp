@@ -109,6 +109,7 @@ class OrderedPool {
         done_(slots_.size()),
         waiting_(slots_.size(), nullptr) {
     for (Slot& s : slots_) release(&s);
+    trim_scratch_.reserve(slots_.size());
     workers_.reserve(params_.workers);
     for (std::size_t i = 0; i < params_.workers; ++i) workers_.emplace_back([this] { work(); });
   }
@@ -193,6 +194,30 @@ class OrderedPool {
   [[nodiscard]] const PoolParams& params() const { return params_; }
   // Slots: a bound on the tickets outstanding at any time (submitted and not yet delivered).
   [[nodiscard]] std::size_t slots() const { return slots_.size(); }
+  // Producer, while nothing is outstanding: hands the free slots other than the `keep` most recently used to
+  // `trim(input, output)` (which frees their buffers, say by assigning a default value). A burst (a sensor back after
+  // an outage lets the frames that waited for it go at once) fills more slots than a steady stream reuses; without
+  // this their buffers stay with the process for good. Returns how many were trimmed; 0 when anything is
+  // outstanding; a slot trimmed and not used since is not counted again. Not while another thread submits.
+  template <typename Trim>
+  std::size_t trim_idle(std::size_t keep, Trim&& trim) {
+    if (outstanding() != 0) return 0;
+    std::vector<Slot*>& all = trim_scratch_;  // top of the stack first: the most recently used
+    all.clear();
+    Slot* s = nullptr;
+    while (free_.pop(s)) all.push_back(s);
+    std::size_t trimmed = 0;
+    for (std::size_t i = keep; i < all.size(); ++i) {
+      if (!all[i]->used) continue;  // trimmed before and not used since
+      trim(all[i]->input, all[i]->output);
+      all[i]->has_output = false;
+      all[i]->error = std::string();
+      all[i]->used = false;
+      ++trimmed;
+    }
+    for (auto it = all.rbegin(); it != all.rend(); ++it) release(*it);  // back in the same order
+    return trimmed;
+  }
   // What the system refused of PoolParams::worker, on the first worker that was refused anything; empty when
   // every worker that has started got its settings. Any thread.
   [[nodiscard]] std::string thread_refusal() const {
@@ -208,6 +233,7 @@ class OrderedPool {
     In input{};
     Out output{};  // kept from ticket to ticket, buffers and all (ProcessInto)
     bool has_output = false;
+    bool used = false;  // submitted into since the last trim_idle()
     std::string error;
   };
 
@@ -237,6 +263,7 @@ class OrderedPool {
     }
     using std::swap;
     swap(s->input, in);
+    s->used = true;
     s->has_output = false;
     s->error.clear();
     s->outcome = Outcome::Processed;
@@ -348,6 +375,7 @@ class OrderedPool {
   PoolParams params_;
   ProcessInto process_;
   std::vector<Slot> slots_;
+  std::vector<Slot*> trim_scratch_;  // trim_idle(): reserved for every slot, so it does not allocate
   PtrStack free_;
   PtrQueue input_;
   PtrQueue done_;
