@@ -3,17 +3,24 @@
 // default output, "(1621880457.123456)  can0  18FEF100   [8]  00 FF 00 00 FF FF FF FF" (timestamp optional).
 // One record per frame; 29-bit ids also as J1939 fields (protocols.md §7.4). A line that is neither form, or a
 // form with a bad part, yields no record and is counted by its first bad part.
+// J1939 network management and diagnostics get a record of their own after their frame's: each Address Claimed
+// (or Cannot Claim) with its NAME's fields ("j1939_address_claim"), each DM1 / DM2 with its lamps and DTCs
+// ("j1939_dm1" / "j1939_dm2"), in one frame or reassembled from the broadcast transport protocol (BAM, per
+// interface and source), and any other message that BAM completes ("j1939_bam", its PGN and bytes).
 
 #include <algorithm>
 #include <array>
 #include <charconv>
 #include <cstdio>
+#include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "fieldguard/core/expected.hpp"
+#include "fieldguard/output/j1939.hpp"
 #include "inspect/inspect_format.hpp"
 #include "inspect/json_line.hpp"
 
@@ -275,6 +282,118 @@ std::string record(const Frame& f) {
   return std::move(j).str();
 }
 
+namespace j1939 = output::j1939;
+
+std::string hex_bytes(std::span<const std::uint8_t> b) {
+  constexpr std::string_view kHex = "0123456789ABCDEF";
+  std::string s;
+  for (const std::uint8_t v : b) {
+    s += kHex[v >> 4];
+    s += kHex[v & 0x0F];
+  }
+  return s;
+}
+
+JsonLine j1939_head(const char* type, const Frame& f, std::uint8_t source) {
+  JsonLine j;
+  j.field("type", type).field("time", f.time_s).field("iface", f.iface).field("sa", source);
+  return j;
+}
+
+std::string claim_record(const Frame& f, std::uint8_t source, std::uint64_t v) {
+  const j1939::Name n = j1939::Name::from_value(v);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llX", static_cast<unsigned long long>(v));
+  JsonLine j = j1939_head("j1939_address_claim", f, source);
+  j.boolean("cannot_claim", source == j1939::kNullAddress).field("name", std::string_view(hex));
+  j.field("identity_number", n.identity_number).field("manufacturer_code", n.manufacturer_code);
+  j.field("ecu_instance", n.ecu_instance).field("function_instance", n.function_instance);
+  j.field("function", n.function).field("vehicle_system", n.vehicle_system);
+  j.field("vehicle_system_instance", n.vehicle_system_instance).field("industry_group", n.industry_group);
+  j.boolean("arbitrary_address_capable", n.arbitrary_address_capable);
+  return std::move(j).str();
+}
+
+// A DM1 / DM2 record, or nullopt when its bytes do not decode (counted by the caller).
+std::optional<std::string> diagnostic_record(const Frame& f, std::uint8_t source, std::uint32_t pgn,
+                                             std::span<const std::uint8_t> data, bool transport) {
+  const auto d = j1939::decode_diagnostic(data);
+  if (!d) return std::nullopt;
+  JsonLine j = j1939_head(pgn == j1939::kPgnDm1 ? "j1939_dm1" : "j1939_dm2", f, source);
+  JsonLine lamps;
+  lamps.field("malfunction", j1939::to_string(d->lamps.malfunction))
+      .field("red_stop", j1939::to_string(d->lamps.red_stop))
+      .field("amber_warning", j1939::to_string(d->lamps.amber_warning))
+      .field("protect", j1939::to_string(d->lamps.protect));
+  j.object("lamps", std::move(lamps));
+  JsonLine::Json dtcs = JsonLine::Json::array();
+  for (const j1939::Dtc& t : d->dtcs) dtcs.push_back({{"spn", t.spn}, {"fmi", t.fmi}, {"occurrences", t.occurrences}});
+  j.value("dtcs", std::move(dtcs)).boolean("transport", transport);
+  return std::move(j).str();
+}
+
+// The J1939 records a frame gives (none for most), and their counts.
+class J1939Reader {
+ public:
+  void take(const Frame& f, Output& out, Summary& summary) {
+    if (!f.extended || f.error_frame || f.rtr || f.fd || f.len > 8) return;
+    output::CanFrame c;
+    c.id = f.id & kEffMask;
+    c.len = static_cast<std::uint8_t>(f.len);
+    std::copy_n(f.data.begin(), f.len, c.data.begin());
+    const output::J1939Fields id = output::j1939_fields(c.id);
+    const std::span<const std::uint8_t> data(c.data.data(), c.len);
+    if (id.pgn == j1939::kPgnAddressClaimed && c.len == 8) {
+      out.line(claim_record(f, id.source, j1939::name_from_bytes(std::span<const std::uint8_t, 8>(c.data))));
+      ++summary.kinds["j1939_address_claim"];
+    } else if ((id.pgn == j1939::kPgnDm1 || id.pgn == j1939::kPgnDm2) && c.len == 8) {
+      diagnostic(f, id.source, id.pgn, data, false, out, summary);
+    }
+    auto& rx = receivers_[std::string(f.iface)];
+    if (auto m = rx.feed(c, f.time_s.value_or(0.0))) {
+      if (m->pgn == j1939::kPgnDm1 || m->pgn == j1939::kPgnDm2) {
+        diagnostic(f, m->source, m->pgn, m->data, true, out, summary);
+      } else {
+        JsonLine j = j1939_head("j1939_bam", f, m->source);
+        j.field("pgn", m->pgn).field("size", m->data.size()).field("data", hex_bytes(m->data));
+        out.line(std::move(j).str());
+        ++summary.kinds["j1939_bam"];
+      }
+    }
+  }
+
+  void finish(Summary& summary) const {
+    j1939::BamReceiver::Counters c;
+    for (const auto& [iface, rx] : receivers_) {
+      c.completed += rx.counters().completed;
+      c.dropped_sequence += rx.counters().dropped_sequence;
+      c.dropped_restart += rx.counters().dropped_restart;
+      c.dropped_timeout += rx.counters().dropped_timeout;
+      c.bad_announcements += rx.counters().bad_announcements;
+    }
+    summary.extra.emplace_back("bam_completed", c.completed);
+    summary.rejections.emplace_back("bam_out_of_sequence", c.dropped_sequence);
+    summary.rejections.emplace_back("bam_announced_again", c.dropped_restart);
+    summary.rejections.emplace_back("bam_timed_out", c.dropped_timeout);
+    summary.rejections.emplace_back("bam_bad_announcement", c.bad_announcements);
+    summary.rejections.emplace_back("j1939_bad_diagnostic", bad_diagnostic_);
+  }
+
+ private:
+  void diagnostic(const Frame& f, std::uint8_t source, std::uint32_t pgn, std::span<const std::uint8_t> data,
+                  bool transport, Output& out, Summary& summary) {
+    if (auto r = diagnostic_record(f, source, pgn, data, transport)) {
+      out.line(*r);
+      ++summary.kinds[pgn == j1939::kPgnDm1 ? "j1939_dm1" : "j1939_dm2"];
+    } else {
+      ++bad_diagnostic_;
+    }
+  }
+
+  std::map<std::string, j1939::BamReceiver> receivers_;
+  std::uint64_t bad_diagnostic_ = 0;
+};
+
 std::string_view trim_cr(std::string_view line) {
   while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.remove_suffix(1);
   return line;
@@ -303,6 +422,7 @@ bool looks_like_candump(ByteSpan head) {
 void inspect_candump(Capture& in, Output& out, Summary& summary) {
   summary.kinds["can"] = 0;
   summary.kinds["can_error"] = 0;
+  for (const char* k : {"j1939_address_claim", "j1939_dm1", "j1939_dm2", "j1939_bam"}) summary.kinds[k] = 0;
   std::array<std::uint64_t, kLineErrorNames.size()> errors{};
   std::uint64_t lines = 0;
   std::uint64_t blank_lines = 0;
@@ -310,6 +430,7 @@ void inspect_candump(Capture& in, Output& out, Summary& summary) {
   std::uint64_t extended = 0;
   std::string line;
   bool too_long = false;
+  J1939Reader j1939;
   const auto take = [&] {
     ++lines;
     if (too_long) {
@@ -320,6 +441,7 @@ void inspect_candump(Capture& in, Output& out, Summary& summary) {
       ++summary.kinds[f->error_frame ? "can_error" : "can"];
       if (!f->error_frame) ++(f->extended ? extended : standard);
       out.line(record(*f));
+      j1939.take(*f, out, summary);
     } else {
       ++errors[static_cast<std::size_t>(f.error())];
     }
@@ -340,6 +462,7 @@ void inspect_candump(Capture& in, Output& out, Summary& summary) {
   if (!line.empty() || too_long) take();  // the last line, without its newline
   for (std::size_t k = 0; k < errors.size(); ++k) summary.rejections.emplace_back(kLineErrorNames[k], errors[k]);
   summary.extra = {{"lines", lines}, {"blank_lines", blank_lines}, {"standard", standard}, {"extended", extended}};
+  j1939.finish(summary);
 }
 
 }  // namespace fieldguard::app::inspect

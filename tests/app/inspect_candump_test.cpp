@@ -32,8 +32,11 @@ TEST(InspectCandump, RealJ1939TruckLog) {
   std::size_t bad = 0;
   const auto r = testing::json_lines(run.output, &bad);
   EXPECT_EQ(bad, 0U);
-  ASSERT_EQ(r.size(), 300U);
+  ASSERT_EQ(r.size(), 301U);  // a record per frame, and the DM1 its BAM carried
   EXPECT_EQ(summary_number(run.output, "can"), 300);
+  EXPECT_EQ(summary_number(run.output, "j1939_dm1"), 1);
+  EXPECT_EQ(summary_number(run.output, "j1939_address_claim"), 0);  // none in this log
+  EXPECT_EQ(summary_number(run.output, "bam_completed"), 1);
   EXPECT_EQ(summary_number(run.output, "rejected"), 0);
   EXPECT_EQ(summary_number(run.output, "extended"), 300);
 
@@ -48,7 +51,27 @@ TEST(InspectCandump, RealJ1939TruckLog) {
 
   std::size_t eec1 = 0;
   std::size_t ccvs1 = 0;
+  std::size_t dm1 = 0;
   for (const auto& f : r) {
+    if (f.at("type").get<std::string>() == "j1939_dm1") {
+      // The engine's DM1 by BAM (lines 178-252): right after the frame that completed it, at its time.
+      ++dm1;
+      EXPECT_EQ(f.at("time").get<double>(), 1635188455.718900);
+      EXPECT_EQ(f.at("sa").get<long long>(), 0x00);
+      EXPECT_TRUE(f.at("transport").get<bool>());
+      EXPECT_EQ(f.at("lamps").at("malfunction").get<std::string>(), "on");
+      EXPECT_EQ(f.at("lamps").at("protect").get<std::string>(), "not available");
+      const auto& d = f.at("dtcs");
+      ASSERT_EQ(d.size(), 4U);
+      EXPECT_EQ(d[0].at("spn").get<long long>(), 980);
+      EXPECT_EQ(d[0].at("fmi").get<long long>(), 9);
+      EXPECT_EQ(d[0].at("occurrences").get<long long>(), 126);
+      EXPECT_EQ(d[1].at("spn").get<long long>(), 3216);
+      EXPECT_EQ(d[1].at("fmi").get<long long>(), 20);
+      EXPECT_EQ(d[3].at("spn").get<long long>(), 609);
+      EXPECT_EQ(d[3].at("fmi").get<long long>(), 12);
+      continue;
+    }
     if (f.at("id").get<std::string>() == "0CF00400") {  // EEC1, 100 Hz while the engine idles
       ++eec1;
       EXPECT_EQ(f.at("pgn").get<long long>(), 61444);  // 0xF004
@@ -67,6 +90,46 @@ TEST(InspectCandump, RealJ1939TruckLog) {
   }
   EXPECT_EQ(eec1, 84U);
   EXPECT_EQ(ccvs1, 9U);
+  EXPECT_EQ(dm1, 1U);
+}
+
+// Address claims with their NAME's fields (a vendor's claim printed in its manual, 18EEFF21; a Cannot Claim from the
+// null address), a DM1 in one frame, and a DM1 whose bytes do not decode (counted, no record).
+TEST(InspectCandump, J1939AddressClaimsAndDiagnostics) {
+  TempDir dir;
+  const std::string text =
+      "(1.000000) can0 18EEFF21#3F426F1A00823CC0\n"
+      "(1.100000) can0 18EEFFFE#3F426F1A00823CC0\n"
+      "(1.200000) can1 18FECA80#04FF00FFFF01FFFF\n"
+      "(1.300000) can1 18FECA80#04FF0102030405FF\n";
+  const auto run = run_fieldguard("inspect --format candump " + write(dir, "j1939.log", text));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto r = testing::json_lines(run.output);
+  ASSERT_EQ(r.size(), 7U) << run.output;  // 4 frames, 2 claims, 1 DM1
+  const auto& claim = r[1];
+  EXPECT_EQ(claim.at("type").get<std::string>(), "j1939_address_claim");
+  EXPECT_EQ(claim.at("sa").get<long long>(), 0x21);
+  EXPECT_FALSE(claim.at("cannot_claim").get<bool>());
+  EXPECT_EQ(claim.at("name").get<std::string>(), "C03C82001A6F423F");
+  EXPECT_EQ(claim.at("identity_number").get<long long>(), 999999);
+  EXPECT_EQ(claim.at("manufacturer_code").get<long long>(), 211);
+  EXPECT_EQ(claim.at("function").get<long long>(), 130);
+  EXPECT_EQ(claim.at("vehicle_system").get<long long>(), 30);
+  EXPECT_EQ(claim.at("industry_group").get<long long>(), 4);
+  EXPECT_TRUE(claim.at("arbitrary_address_capable").get<bool>());
+  EXPECT_TRUE(r[3].at("cannot_claim").get<bool>());
+  const auto& dm1 = r[5];
+  EXPECT_EQ(dm1.at("type").get<std::string>(), "j1939_dm1");
+  EXPECT_EQ(dm1.at("iface").get<std::string>(), "can1");
+  EXPECT_EQ(dm1.at("sa").get<long long>(), 0x80);
+  EXPECT_FALSE(dm1.at("transport").get<bool>());
+  EXPECT_EQ(dm1.at("lamps").at("amber_warning").get<std::string>(), "on");
+  ASSERT_EQ(dm1.at("dtcs").size(), 1U);
+  EXPECT_EQ(dm1.at("dtcs")[0].at("spn").get<long long>(), 0x7FF00);
+  EXPECT_EQ(dm1.at("dtcs")[0].at("fmi").get<long long>(), 31);
+  EXPECT_EQ(summary_number(run.output, "j1939_address_claim"), 2);
+  EXPECT_EQ(summary_number(run.output, "j1939_dm1"), 1);
+  EXPECT_EQ(summary_number(run.output, "j1939_bad_diagnostic"), 1);
 }
 
 TEST(InspectCandump, EveryFrameFormOfTheLogFormat) {
