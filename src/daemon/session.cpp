@@ -192,6 +192,8 @@ void Session::on_tick(std::chrono::nanoseconds late) {
           in = FrameJob{};
           out = DetectedFrame{};
         });
+    // So do the spare rotation and frame buffers none took in that second.
+    trimmed_spares_ += fusion_.trim_spares();
   }
   if (!stalled && ready_) notify_.progress(SteadyClock::now());
 }
@@ -243,9 +245,9 @@ void Session::print_summary() const {
   std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", u(c.stop_frames), u(c.go_frames), u(c.changes));
   if (cfg_.perception.hold.enabled) std::printf("  held obstacles    %llu (from fragments)\n", u(held_));
   std::printf(
-      "  pool              %llu submitted, %llu dropped, %llu refused, %llu failed; %llu slots gave their buffers back "
-      "after bursts\n",
-      u(pc.submitted), u(pc.dropped), u(pc.refused), u(pc.failed), u(trimmed_slots_));
+      "  pool              %llu submitted, %llu dropped, %llu refused, %llu failed; after bursts %llu slots and %llu "
+      "spare buffers gave their memory back\n",
+      u(pc.submitted), u(pc.dropped), u(pc.refused), u(pc.failed), u(trimmed_slots_), u(trimmed_spares_));
   std::printf("  3d lidar          %llu packets, %llu decoded, %llu bad length, %llu full rotations, %llu partial\n",
               u(sc.packets), u(sc.decoded), u(bad_length_), u(sc.full_rotations), u(sc.partial_rotations));
   if (const sync::Synchronizer* sy = fusion_.synchronizer()) {

@@ -144,7 +144,8 @@ class Session {
   std::uint64_t warm_frames_ = 0;  // frames decided when they were taken
   bool stopped_ = false;
   SteadyClock::time_point last_status_{};
-  std::uint64_t trimmed_slots_ = 0;  // pool slots whose buffers went back (OrderedPool::trim_idle)
+  std::uint64_t trimmed_slots_ = 0;   // pool slots whose buffers went back (OrderedPool::trim_idle)
+  std::uint64_t trimmed_spares_ = 0;  // spare buffers freed (SensorFusion::trim_spares)
 };
 
 }  // namespace fieldguard::app

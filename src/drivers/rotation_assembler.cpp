@@ -27,8 +27,6 @@ constexpr int kStepBackCdeg = 1000;
 // 1/8 plus two packets' worth makes a reallocation inside a frame rare. (The last frame, not the largest ever: one
 // overlong frame, after the sensor stood still, must not size every later buffer.)
 constexpr std::size_t kHeadroomPoints = 2 * 384;
-// Recycled buffers kept at most (each one rotation's worth).
-constexpr std::size_t kMaxSpareBuffers = 2;
 
 // Points constructed at a time when a buffer needs room (128 KiB): a buffer's points are value-initialised once in
 // its life (resize() cannot leave them uninitialised), in steps of this many rather than packet by packet, and a
@@ -58,13 +56,13 @@ RotationAssembler::RotationAssembler(double cut_deg, RotationClose close) : clos
 
 std::vector<LidarPoint> RotationAssembler::fresh_buffer() {
   std::vector<LidarPoint> b;
-  if (!spare_.empty()) {
-    b = std::move(spare_.back());
-    spare_.pop_back();
-  }
+  (void)spare_.take(b);
   const std::size_t want = last_frame_points_ + last_frame_points_ / 8 + kHeadroomPoints;
-  if (b.capacity() < want) {
-    b.clear();  // nothing to keep: reserve() need not copy the old points
+  // Too small, or far too big (more than four rotations' room: grown by an overlong rotation, after the sensor
+  // stood still or came back; a synchronizer hands back buffers with room for a frame of two or three): a buffer
+  // of the right size, so that no outage leaves the process holding its largest buffers for good.
+  if (b.capacity() < want || (last_frame_points_ > 0 && b.capacity() > 4 * want)) {
+    b = std::vector<LidarPoint>();  // nothing to keep: reserve() need not copy the old points
     b.reserve(want);
   }
   return b;
@@ -279,7 +277,7 @@ void RotationAssembler::finish(std::vector<LidarFrame>& done) {
 }
 
 void RotationAssembler::recycle(LidarFrame&& frame) {
-  if (spare_.size() < kMaxSpareBuffers && frame.points.capacity() > 0) spare_.push_back(std::move(frame.points));
+  if (frame.points.capacity() > 0) (void)spare_.put(std::move(frame.points));
   frame = LidarFrame{};
 }
 

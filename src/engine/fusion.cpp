@@ -192,6 +192,8 @@ void SensorFusion::frames_to(Stamp host, std::vector<FrameJob>& out) {
   }
 }
 
+std::size_t SensorFusion::trim_spares() { return stream_->trim_spares() + (sync_ ? sync_->trim_spares() : 0); }
+
 void SensorFusion::recycle(FrameJob& job) {
   if (job.rotation.points.capacity() > 0) stream_->recycle(std::move(job.rotation));
   if (job.synced && sync_) {

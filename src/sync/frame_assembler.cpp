@@ -217,9 +217,7 @@ std::optional<SensorKind> FrameAssembler::waiting_for() const {
   return std::nullopt;
 }
 
-void FrameAssembler::recycle(SyncedFrame&& frame) {
-  if (spare_frames_.size() < kMaxSpare) spare_frames_.push_back(std::move(frame));
-}
+void FrameAssembler::recycle(SyncedFrame&& frame) { (void)spare_frames_.put(std::move(frame)); }
 
 bool FrameAssembler::take_spare_points(std::vector<LidarPoint>& out) {
   if (spare_points_.empty()) return false;
@@ -230,10 +228,7 @@ bool FrameAssembler::take_spare_points(std::vector<LidarPoint>& out) {
 
 SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   SyncedFrame f;
-  if (!spare_frames_.empty()) {
-    f = std::move(spare_frames_.back());
-    spare_frames_.pop_back();
-  }
+  (void)spare_frames_.take(f);
   f.seq = next_seq_++;
   f.window_start = w.start;
   f.window_end = w.end;
@@ -275,8 +270,8 @@ SyncedFrame FrameAssembler::build(Window&& w, bool timed_out) {
   const std::size_t frame_room = n + n / 8;
   for (LidarRotation& r : w.rotations) {
     if (r.points.capacity() == 0 || spare_points_.size() >= kMaxSpare) continue;
-    if (w.rotations.size() > 1 && r.points.capacity() < frame_room) {
-      r.points.clear();  // nothing to keep: reserve() need not copy
+    if (w.rotations.size() > 1 && (r.points.capacity() < frame_room || r.points.capacity() > 2 * frame_room)) {
+      r.points = std::vector<LidarPoint>();  // nothing to keep; and one grown by a burst goes back to the system
       r.points.reserve(frame_room);
     }
     // Otherwise not cleared: the rotation assembler writes over the points it holds (RotationAssembler::recycle())

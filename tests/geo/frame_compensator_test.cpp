@@ -641,6 +641,33 @@ TEST(FrameCompensator, OutputIsClearedAndReused) {
   EXPECT_EQ(out.stats.gnss_used, 0U);
 }
 
+// The output's room follows the frames: a frame twice as big (as when a sensor comes back and a window holds more
+// rotations) does not leave every later frame in a buffer of its size, and a steady stream keeps its buffer (no
+// reallocation from frame to frame).
+TEST(FrameCompensator, OutputRoomShrinksBackAfterAnOverlongFrame) {
+  const CompensationParams params = base_params();
+  const FrameCompensator comp(params);
+  const Truth truth;
+  sync::SyncedFrame f = make_frame(truth, params);
+  f.points = ground_seen(truth, params.lidar);
+  sync::SyncedFrame big = f;
+  big.points.insert(big.points.end(), f.points.begin(), f.points.end());
+  CompensatedFrame out;
+  comp.compensate(f, out);
+  const std::size_t n = out.points.size();
+  const LidarPoint* steady = out.points.data();
+  comp.compensate(f, out);
+  EXPECT_EQ(out.points.data(), steady) << "a steady stream reallocated";
+  comp.compensate(big, out);
+  EXPECT_GE(out.points.capacity(), 2 * n);
+  comp.compensate(f, out);
+  EXPECT_EQ(out.points.size(), n);
+  EXPECT_LE(2 * out.points.capacity(), 3 * n + 3) << "the overlong frame's room kept";
+  steady = out.points.data();
+  comp.compensate(f, out);
+  EXPECT_EQ(out.points.data(), steady);
+}
+
 // The working storage travels with the output (a worker reuses both): nothing of one frame, nor of another
 // compensator's track limits, leaks into the next: bit for bit what a fresh output gives.
 TEST(FrameCompensator, ReusedWorkGivesWhatAFreshOutputGives) {

@@ -48,6 +48,7 @@ class Stream {
   // Optional: hands back a frame the consumer is done with, so that its point buffer is reused for a later
   // rotation (RotationAssembler::recycle()).
   void recycle(LidarFrame&& frame) { assembler_.recycle(std::move(frame)); }
+  std::size_t trim_spares() { return assembler_.trim_spares(); }  // RotationAssembler::trim_spares()
 
   [[nodiscard]] const StreamCounters& counters() const { return counters_; }
   [[nodiscard]] const Decoder& decoder() const { return decoder_; }

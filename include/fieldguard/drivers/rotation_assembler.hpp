@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/core/spare_list.hpp"
 
 namespace fieldguard {
 
@@ -73,6 +74,8 @@ class RotationAssembler {
   // Optional: hands back a frame the consumer is done with, so that its point buffer (4.4 MB for a 5 Hz
   // HDL-32E rotation) is reused for a later frame instead of being freed, allocated and initialised again.
   void recycle(LidarFrame&& frame);
+  // Frees the recycled buffers that sat unused since the last call (SpareList::trim()); returns how many.
+  std::size_t trim_spares() { return spare_.trim(); }
 
   [[nodiscard]] std::uint64_t frames_emitted() const { return next_index_; }
 
@@ -101,8 +104,8 @@ class RotationAssembler {
   bool current_started_at_cut_ = false;
   int prev_rel_cdeg_ = -1;  // previous point's azimuth relative to the cut, 0..35999
   std::uint64_t next_index_ = 0;
-  std::size_t last_frame_points_ = 0;           // points of the last frame emitted (sizes the next buffer)
-  std::vector<std::vector<LidarPoint>> spare_;  // recycled point buffers
+  std::size_t last_frame_points_ = 0;            // points of the last frame emitted (sizes the next buffer)
+  SpareList<std::vector<LidarPoint>> spare_{2};  // recycled point buffers
 };
 
 }  // namespace fieldguard

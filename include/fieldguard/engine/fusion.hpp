@@ -174,6 +174,9 @@ class SensorFusion {
   // A job the pool handed back (OrderedPool::submit() swaps in the slot's earlier input): its buffers go back to
   // the 3D LiDAR's stream and the synchronizer, so that a steady stream allocates nothing once warm.
   void recycle(FrameJob& job);
+  // Frees the spare buffers (rotations, frames) that sat unused since the last call, as after a burst; call it
+  // now and then (the daemon: every second). Returns how many.
+  std::size_t trim_spares();
 
   [[nodiscard]] const velodyne::Stream& stream() const { return *stream_; }
   [[nodiscard]] const sync::Synchronizer* synchronizer() const { return sync_.get(); }

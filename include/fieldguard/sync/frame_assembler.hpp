@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "fieldguard/core/spare_list.hpp"
 #include "fieldguard/sync/synced_frame.hpp"
 
 namespace fieldguard::sync {
@@ -77,6 +78,8 @@ class FrameAssembler {
   // a few.
   void recycle(SyncedFrame&& frame);
   bool take_spare_points(std::vector<LidarPoint>& out);
+  // Frees the recycled frames that sat unused since the last call (SpareList::trim()); returns how many.
+  std::size_t trim_spares() { return spare_frames_.trim(); }
 
   // The first required sensor the oldest closed window waits for; nullopt when no window is waiting.
   [[nodiscard]] std::optional<SensorKind> waiting_for() const;
@@ -112,9 +115,9 @@ class FrameAssembler {
   std::optional<Stamp> emitted_until_;  // end of the last emitted window
   std::uint64_t next_seq_ = 0;
   AssemblerCounters counters_;
-  std::vector<SyncedFrame> spare_frames_;              // recycled, at most kMaxSpare
-  std::vector<std::vector<LidarPoint>> spare_points_;  // at most kMaxSpare
   static constexpr std::size_t kMaxSpare = 4;
+  SpareList<SyncedFrame> spare_frames_{kMaxSpare};     // recycled
+  std::vector<std::vector<LidarPoint>> spare_points_;  // at most kMaxSpare, in transit to the rotation assembler
 };
 
 }  // namespace fieldguard::sync

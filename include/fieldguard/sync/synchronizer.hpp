@@ -62,6 +62,7 @@ class Synchronizer {
   // Buffer reuse (FrameAssembler::recycle(), take_spare_points()).
   void recycle(SyncedFrame&& frame) { assembler_.recycle(std::move(frame)); }
   bool take_spare_points(std::vector<LidarPoint>& out) { return assembler_.take_spare_points(out); }
+  std::size_t trim_spares() { return assembler_.trim_spares(); }
 
   // The one-line status; names the sensor the oldest waiting window needs once it has waited waiting_grace_s,
   // or the 3D LiDAR when it has been silent for more than two frame periods.
