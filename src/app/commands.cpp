@@ -210,6 +210,12 @@ Command add_inspect(CLI::App& top) {
       "          default \"can0  18FEF100   [8]  00 FF ...\" output). \"can\": time iface id extended dlc data, for\n"
       "          29-bit ids the J1939 fields priority pgn sa (and da below PF 240), rtr / fd fd_flags / len8_dlc /\n"
       "          dir when they apply. \"can_error\": an error frame (time iface id error_class dlc data).\n"
+      "          After its frame, J1939 network management and diagnostics: \"j1939_address_claim\" (Address\n"
+      "          Claimed, or Cannot Claim from 254): time iface sa cannot_claim name (hex) and the NAME's fields\n"
+      "          identity_number manufacturer_code ecu_instance function_instance function vehicle_system\n"
+      "          vehicle_system_instance industry_group arbitrary_address_capable. \"j1939_dm1\" / \"j1939_dm2\": time\n"
+      "          iface sa lamps (malfunction red_stop amber_warning protect) dtcs (spn fmi occurrences) transport\n"
+      "          (true: reassembled from BAM). \"j1939_bam\": any other message BAM completed: pgn size data.\n"
       "\n"
       "Exit code 0 when the file was read (even with rejections), 2 when it is unusable (missing, empty, a format\n"
       "that cannot be told, a pcap or byte log whose header is broken).\n");
