@@ -137,9 +137,9 @@ DeskewStats run(std::span<const P> points, Stamp base, const PoseTrack& track, c
       continue;
     }
     // Written out: Eigen's product here was a call per point.
-    const double px = p.x;
-    const double py = p.y;
-    const double pz = p.z;
+    const auto px = static_cast<double>(p.x);
+    const auto py = static_cast<double>(p.y);
+    const auto pz = static_cast<double>(p.z);
     const Eigen::Matrix3d& r = xf.r;
     const Eigen::Vector3d v(r(0, 0) * px + r(0, 1) * py + r(0, 2) * pz + xf.t.x(),
                             r(1, 0) * px + r(1, 1) * py + r(1, 2) * pz + xf.t.y(),
