@@ -251,12 +251,7 @@ std::string hex_id(const Frame& f) {
 }
 
 std::string record(const Frame& f) {
-  constexpr std::string_view kHex = "0123456789ABCDEF";
-  std::string data;
-  for (std::size_t k = 0; k < f.len && !f.rtr; ++k) {
-    data += kHex[f.data[k] >> 4];
-    data += kHex[f.data[k] & 0x0F];
-  }
+  const std::string data = f.rtr ? std::string() : hex_upper(std::span<const std::uint8_t>(f.data.data(), f.len));
   JsonLine j;
   j.field("type", f.error_frame ? "can_error" : "can").field("time", f.time_s);
   j.field("iface", f.iface).field("id", hex_id(f));
@@ -283,16 +278,6 @@ std::string record(const Frame& f) {
 }
 
 namespace j1939 = output::j1939;
-
-std::string hex_bytes(std::span<const std::uint8_t> b) {
-  constexpr std::string_view kHex = "0123456789ABCDEF";
-  std::string s;
-  for (const std::uint8_t v : b) {
-    s += kHex[v >> 4];
-    s += kHex[v & 0x0F];
-  }
-  return s;
-}
 
 JsonLine j1939_head(const char* type, const Frame& f, std::uint8_t source) {
   JsonLine j;
@@ -355,7 +340,7 @@ class J1939Reader {
         diagnostic(f, m->source, m->pgn, m->data, true, out, summary);
       } else {
         JsonLine j = j1939_head("j1939_bam", f, m->source);
-        j.field("pgn", m->pgn).field("size", m->data.size()).field("data", hex_bytes(m->data));
+        j.field("pgn", m->pgn).field("size", m->data.size()).field("data", hex_upper(m->data));
         out.line(std::move(j).str());
         ++summary.kinds["j1939_bam"];
       }

@@ -91,6 +91,18 @@ struct Summary {
   std::string unusable;
 };
 
+// Bytes as upper-case hex digits, two per byte ("payload_hex", "data" keys).
+[[nodiscard]] inline std::string hex_upper(std::span<const std::uint8_t> bytes) {
+  constexpr std::string_view kHex = "0123456789ABCDEF";
+  std::string s;
+  s.reserve(bytes.size() * 2);
+  for (const std::uint8_t b : bytes) {
+    s += kHex[b >> 4];
+    s += kHex[b & 0x0F];
+  }
+  return s;
+}
+
 // Seconds since the epoch as the double nearest to the stamp (for "time" keys).
 [[nodiscard]] inline double seconds_of(Stamp t) {
   const std::int64_t s = t.ns / 1'000'000'000;

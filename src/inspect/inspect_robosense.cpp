@@ -34,17 +34,6 @@ std::string utc_iso8601(Stamp t) {
   return buf.data();
 }
 
-template <std::size_t N>
-std::string hex(const std::array<std::uint8_t, N>& bytes) {
-  constexpr std::string_view kHex = "0123456789ABCDEF";
-  std::string s;
-  for (const std::uint8_t b : bytes) {
-    s += kHex[b >> 4];
-    s += kHex[b & 0x0F];
-  }
-  return s;
-}
-
 std::string msop_record(double time_s, std::uint16_t port, const rs::MsopHeader& h, std::uint64_t points) {
   JsonLine j;
   j.field("type", "robosense_msop").field("time", time_s).field("port", port);
@@ -61,8 +50,8 @@ std::string difop_record(double time_s, std::uint16_t port, const rs::DifopInfo&
   JsonLine j;
   j.field("type", "robosense_difop").field("time", time_s).field("port", port);
   j.field("rpm", d.rpm);
-  j.field("firmware_top", hex(d.top_firmware)).field("firmware_bottom", hex(d.bottom_firmware));
-  j.field("serial", hex(d.serial));
+  j.field("firmware_top", hex_upper(d.top_firmware)).field("firmware_bottom", hex_upper(d.bottom_firmware));
+  j.field("serial", hex_upper(d.serial));
   j.field("return_mode", rs::to_string(d.return_mode)).field("return_mode_byte", d.return_mode_byte);
   j.field("distance_unit", rs::to_string(d.distance_unit));
   j.field("fov_start_deg", d.fov_start_cdeg / 100.0).field("fov_end_deg", d.fov_end_cdeg / 100.0);

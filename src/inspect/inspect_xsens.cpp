@@ -123,15 +123,8 @@ std::string message_kind(std::uint8_t mid) {
 }
 
 std::string record(const xs::RawMessage& m) {
-  constexpr std::string_view kHex = "0123456789ABCDEF";
-  std::string hex;
-  hex.reserve(m.payload.size() * 2);
-  for (const std::uint8_t b : m.payload) {
-    hex += kHex[b >> 4];
-    hex += kHex[b & 0x0F];
-  }
   JsonLine j;
-  j.field("type", message_kind(m.mid)).field("mid", m.mid).field("payload_hex", hex);
+  j.field("type", message_kind(m.mid)).field("mid", m.mid).field("payload_hex", hex_upper(m.payload));
   return std::move(j).str();
 }
 
