@@ -271,11 +271,11 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
   std::span<const LidarPoint> points3d(frame.points);
   std::span<const SourcedPoint> points2d(lifted);
   // Room for every point, written by index and trimmed after (a push_back per point cost more than initialising
-  // the room). The 3D points go straight from the sensor into detection points, in one pass.
+  // the room); the 3D points go straight from the sensor into detection points, in one pass. The room is kept from
+  // frame to frame, with an eighth to spare as frames vary, and made anew when too small (resize() would double
+  // it, and keep that for good) or over half as big again as the frame (an overlong frame, as when a sensor comes
+  // back, does not size every later one).
   const std::size_t room_needed = frame.points.size() + lifted.size();
-  // Room kept from frame to frame, with an eighth to spare as frames vary, and made anew when too small (resize()
-  // would double it, and keep that for good) or over half as big again as the frame (an overlong frame, as when a
-  // sensor comes back, does not size every later one).
   if (out.points.capacity() < room_needed || 2 * out.points.capacity() > 3 * room_needed) {
     out.points = std::vector<LidarPoint>();
     out.points.reserve(room_needed + room_needed / 8);

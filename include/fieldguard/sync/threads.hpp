@@ -26,11 +26,6 @@ struct ThreadSettings {
 // empty.
 [[nodiscard]] std::string lock_all_memory();
 
-// Large blocks (`threshold_bytes` and up) each get their own mapping, handed back to the system when freed,
-// whatever was freed before. glibc otherwise raises that threshold to the largest block freed so far (up to
-// 32 MiB), after which the point buffers a sensor outage made the daemon hold come from the heap and stay
-// resident, and locked, after the outage. Empty when it took; what the allocator refused otherwise (other C
-// libraries and sanitizer runtimes: their own allocators).
 // Whether malloc is glibc's (not a sanitizer runtime's, nor another C library's).
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define FIELDGUARD_SANITIZER_MALLOC 1
@@ -45,6 +40,11 @@ inline constexpr bool kGlibcMalloc = true;
 inline constexpr bool kGlibcMalloc = false;
 #endif
 inline constexpr std::size_t kLargeBlockBytes = std::size_t{128} * 1024;  // glibc's own starting threshold
+// Large blocks (`threshold_bytes` and up) each get their own mapping, handed back to the system when freed,
+// whatever was freed before. glibc otherwise raises that threshold to the largest block freed so far (up to
+// 32 MiB), after which the point buffers a sensor outage made the daemon hold come from the heap and stay
+// resident, and locked, after the outage. Empty when it took; what the allocator refused otherwise (other C
+// libraries and sanitizer runtimes: their own allocators).
 [[nodiscard]] std::string give_large_blocks_back(std::size_t threshold_bytes = kLargeBlockBytes);
 
 // "fifo 50", "rr 10", "other": for logs.
