@@ -46,7 +46,7 @@ AddressClaimer::AddressClaimer(const ClaimParams& params)
 }
 
 std::optional<std::uint8_t> AddressClaimer::address() const {
-  if (state_ == ClaimState::Claiming || state_ == ClaimState::Claimed || state_ == ClaimState::BusOff) {
+  if (holding() || state_ == ClaimState::BusOff) {
     if (address_ <= kMaxUnicastAddress) return address_;
   }
   return std::nullopt;
@@ -111,8 +111,7 @@ void AddressClaimer::receive(const CanFrame& f, double now_s, std::vector<CanFra
       if (n == other) n.reset();  // that NAME moved
     }
     claimed_by_[j.source] = other;
-    const bool holding = state_ == ClaimState::Claiming || state_ == ClaimState::Claimed;
-    if (!holding || j.source != address_) return;
+    if (!holding() || j.source != address_) return;
     if (name_ < other) {  // ours has priority: claim again, the other node must yield
       ++counters_.contests_won;
       out.push_back(address_claimed(name_, address_));
@@ -126,10 +125,9 @@ void AddressClaimer::receive(const CanFrame& f, double now_s, std::vector<CanFra
   if (j.pgn == kPgnRequest) {
     const auto pgn = requested_pgn(std::span<const std::uint8_t>(f.data.data(), f.len));
     if (!pgn || *pgn != kPgnAddressClaimed) return;
-    const bool to_us = j.destination == kGlobalAddress ||
-                       ((state_ == ClaimState::Claiming || state_ == ClaimState::Claimed) && j.destination == address_);
+    const bool to_us = j.destination == kGlobalAddress || (holding() && j.destination == address_);
     if (!to_us) return;
-    if (state_ == ClaimState::Claiming || state_ == ClaimState::Claimed) {
+    if (holding()) {
       out.push_back(address_claimed(name_, address_));
       ++counters_.requests_answered;
     } else if (state_ == ClaimState::CannotClaim && !cannot_claim_due_s_) {
@@ -154,7 +152,7 @@ std::optional<double> AddressClaimer::next_due(double now_s) const {
 }
 
 void AddressClaimer::bus_off() {
-  if (state_ == ClaimState::Claiming || state_ == ClaimState::Claimed) state_ = ClaimState::BusOff;
+  if (holding()) state_ = ClaimState::BusOff;
 }
 
 void AddressClaimer::bus_recovered(double now_s, std::vector<CanFrame>& out) {

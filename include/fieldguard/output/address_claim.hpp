@@ -76,6 +76,8 @@ class AddressClaimer {
   [[nodiscard]] std::optional<double> next_due(double now_s) const;
 
  private:
+  // Claiming or Claimed: an address is ours to defend and to answer requests with.
+  [[nodiscard]] bool holding() const { return state_ == ClaimState::Claiming || state_ == ClaimState::Claimed; }
   void claim(std::uint8_t address, double now_s, std::vector<CanFrame>& out);
   void lose(double now_s, std::vector<CanFrame>& out);
   [[nodiscard]] double answer_delay_s();
