@@ -78,5 +78,37 @@ TEST(Diagnostics, NothingWhileStartingUp) {
   EXPECT_EQ(encode_diagnostic(m).size(), 8U);  // the no-DTC DM1: one frame
 }
 
+TEST(Diagnostics, TheBusOwnFaultsWarnWithoutTheStopLamp) {
+  Diagnostics dg;
+  safety::Decision starting;
+  starting.reasons = safety::bit(safety::Reason::StartingUp);
+  BusFaults bus;
+  bus.send_errors = true;
+  const DiagnosticMessage m = dg.update(starting, bus);  // a bus fault is one from the start
+  ASSERT_EQ(m.dtcs.size(), 1U);
+  EXPECT_EQ(m.dtcs[0], (Dtc{520201, 12, 1}));
+  EXPECT_EQ(m.lamps.amber_warning, Lamp::On);
+  EXPECT_EQ(m.lamps.red_stop, Lamp::Off) << "the tractor is stopped for starting up, not for the bus";
+  bus = {};
+  bus.address_conflict = true;
+  const DiagnosticMessage c = dg.update(go(), bus);
+  ASSERT_EQ(c.dtcs.size(), 1U);
+  EXPECT_EQ(c.dtcs[0], (Dtc{520201, 31, 1}));
+}
+
+TEST(Diagnostics, PreviouslyActiveKeepsTheCountsOfClearedFaults) {
+  Diagnostics dg;
+  EXPECT_TRUE(dg.previously_active().dtcs.empty());
+  (void)dg.update(fault(safety::bit(safety::Sensor::Scan2d), 0));
+  EXPECT_TRUE(dg.previously_active().dtcs.empty()) << "still active: DM1's, not DM2's";
+  (void)dg.update(go());
+  (void)dg.update(fault(safety::bit(safety::Sensor::Scan2d), 0));
+  (void)dg.update(fault(0, safety::bit(safety::Sensor::Gnss)));
+  const DiagnosticMessage m = dg.previously_active();
+  ASSERT_EQ(m.dtcs.size(), 1U);
+  EXPECT_EQ(m.dtcs[0], (Dtc{520193, 9, 2}));
+  EXPECT_EQ(m.lamps.amber_warning, Lamp::Off);
+}
+
 }  // namespace
 }  // namespace fieldguard::output::j1939
