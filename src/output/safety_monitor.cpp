@@ -17,6 +17,7 @@ std::string_view to_string(Reason r) {
     case Reason::PipelineLate: return "pipeline late";
     case Reason::StartingUp: return "starting up";
     case Reason::ImplausibleData: return "implausible data";
+    case Reason::NoAddress: return "no CAN address";
   }
   return "unknown reason";
 }
@@ -173,6 +174,7 @@ Decision Monitor::update(const Input& in) {
   if (implausible != 0) set(Reason::ImplausibleData);
   if (frame_late_latched_ || stalled) set(Reason::PipelineLate);
   if (obstacle_latched_) set(Reason::ObstacleInZone);
+  if (in.no_address) set(Reason::NoAddress);
 
   if (reasons != 0) {
     clear_ = 0;
@@ -238,6 +240,9 @@ Decision Monitor::update(const Input& in) {
         if (!detail.empty()) detail += ", ";
         detail += std::string(to_string(static_cast<Sensor>(i))) + " " + std::string(to_string(in.sensors[i].problem));
       }
+      break;
+    case Reason::NoAddress:
+      detail = "another node holds our J1939 address and no other is free: nothing we send reaches the controller";
       break;
     case Reason::PipelineLate:
       if (!frame_late_latched_) {

@@ -49,6 +49,7 @@ class Drive {
   void silence(Sensor s) { silent_[static_cast<std::size_t>(s)] = true; }
   void resume(Sensor s) { silent_[static_cast<std::size_t>(s)] = false; }
   void problem(Sensor s, Problem p) { problem_[static_cast<std::size_t>(s)] = p; }
+  void no_address(bool v) { no_address_ = v; }
   [[nodiscard]] std::int64_t now() const { return t_; }
 
   Params params;
@@ -59,6 +60,7 @@ class Drive {
   Input inputs() {
     Input in;
     in.now = Stamp{t_};
+    in.no_address = no_address_;
     for (std::size_t i = 0; i < kSensorCount; ++i) {
       if (!silent_[i]) last_[i] = t_ - 10 * kMs;  // heard 10 ms ago
       in.sensors[i].last_data = Stamp{last_[i]};
@@ -76,6 +78,7 @@ class Drive {
   std::array<bool, kSensorCount> silent_{};
   std::array<std::int64_t, kSensorCount> last_{};
   std::array<Problem, kSensorCount> problem_{};
+  bool no_address_ = false;
 };
 
 Params lidar_and_ahrs() {
@@ -348,6 +351,25 @@ TEST(SafetyMonitor, HighestReasonIsReportedWithEveryActiveOneInTheMask) {
   EXPECT_EQ(r.reason, Reason::SensorFault);
   EXPECT_EQ(r.reasons, bit(Reason::SensorFault) | bit(Reason::ImplausibleData) | bit(Reason::ObstacleInZone));
   EXPECT_EQ(r.implausible_sensors, bit(Sensor::Lidar));
+}
+
+TEST(SafetyMonitor, NoCanAddressStopsAheadOfEveryOtherReason) {
+  Drive d = started();
+  d.silence(Sensor::Ahrs);
+  d.no_address(true);
+  const Decision s = d.tick(400);
+  EXPECT_TRUE(s.stop);
+  EXPECT_EQ(s.reason, Reason::NoAddress);
+  EXPECT_NE(s.reasons & bit(Reason::SensorFault), 0) << "the silent AHRS stays in the mask";
+  ASSERT_TRUE(s.event);
+  EXPECT_EQ(s.event->text.rfind("stop: no CAN address", 0), 0U) << s.event->text;
+  EXPECT_NE(s.event->text.find("another node holds our J1939 address"), std::string::npos) << s.event->text;
+  d.resume(Sensor::Ahrs);
+  d.no_address(false);
+  EXPECT_TRUE(d.frame().stop) << "an address again, then the clear frames as for any reason";
+  Decision last;
+  for (int i = 0; i < d.params.clear_frames; ++i) last = d.frame();
+  EXPECT_FALSE(last.stop);
 }
 
 TEST(SafetyMonitor, ChangeOfReasonIsOneEvent) {

@@ -23,7 +23,7 @@
 namespace fieldguard::output::safety {
 
 // Values 1..4 follow the list of stop reasons (obstacle in zone, sensor fault, pipeline late,
-// starting up); implausible data is ours.
+// starting up); implausible data and no address are ours.
 enum class Reason : std::uint8_t {
   None = 0,
   ObstacleInZone = 1,
@@ -31,15 +31,17 @@ enum class Reason : std::uint8_t {
   PipelineLate = 3,
   StartingUp = 4,
   ImplausibleData = 5,
+  NoAddress = 6,  // J1939: no source address to send from (lost the contest, none left): nothing reaches the controller
 };
 [[nodiscard]] std::string_view to_string(Reason r);  // "obstacle in zone", ...
 [[nodiscard]] constexpr std::uint8_t bit(Reason r) {
   return r == Reason::None ? std::uint8_t{0} : static_cast<std::uint8_t>(1U << (static_cast<unsigned>(r) - 1U));
 }
-// The reason reported when several are active, highest first: what makes the monitor's own view doubtful
-// (a sensor down, data wrong, the pipeline behind) comes before what it sees, and start-up last.
-inline constexpr Reason kReasonPriority[] = {Reason::SensorFault, Reason::ImplausibleData, Reason::PipelineLate,
-                                             Reason::ObstacleInZone, Reason::StartingUp};
+// The reason reported when several are active, highest first: the stop request reaching nobody, then what makes
+// the monitor's own view doubtful (a sensor down, data wrong, the pipeline behind) comes before what it sees, and
+// start-up last.
+inline constexpr Reason kReasonPriority[] = {Reason::NoAddress,    Reason::SensorFault,    Reason::ImplausibleData,
+                                             Reason::PipelineLate, Reason::ObstacleInZone, Reason::StartingUp};
 
 // What the app knows about one sensor at the time of the update.
 struct SensorInput {
@@ -58,6 +60,7 @@ struct Input {
   Stamp now;  // host time of this decision (the clock of every other host time)
   std::array<SensorInput, kSensorCount> sensors{};
   const FrameInput* frame = nullptr;  // nullptr: a tick between frames (timeouts only; counts no clear frame)
+  bool no_address = false;            // the CAN node has no J1939 address (address_claim.hpp: cannot claim)
 };
 
 struct Zone {
