@@ -62,15 +62,20 @@ std::uint8_t payload_crc(const CanFrame& f, const Signal& crc_signal) {
   return crc8<kCrc8SaeJ1850>(std::span<const std::uint8_t>(f.data.data(), n));
 }
 
-CanEncoder::CanEncoder(const CanParams& p) : params_(p) {
+CanEncoder::CanEncoder(const CanParams& p) {
+  reconfigure(p);
+  order_.reserve(64);
+}
+
+void CanEncoder::reconfigure(const CanParams& p) {
   const auto problems = validate(p);
   if (!problems.empty()) {
     std::string all = "invalid CAN parameters:";
     for (const auto& s : problems) all += "\n  " + s;
     throw std::invalid_argument(all);
   }
+  params_ = p;
   for (std::size_t i = 0; i < kMessageCount; ++i) ids_[i] = message_id(p, static_cast<MessageId>(i));
-  order_.reserve(64);
 }
 
 bool CanEncoder::put(CanFrame& f, const Signal& s, double value) {

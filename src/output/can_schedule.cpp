@@ -10,6 +10,11 @@ CanSchedule::CanSchedule(CanEncoder& encoder, CanSink& sink, Nanos period)
   buf_.reserve(kMaxObstacleMessages + 4);
 }
 
+void CanSchedule::set_period(Nanos period) {
+  if (period.count() <= 0) throw std::invalid_argument("CanSchedule: the period must be positive");
+  period_ns_ = period.count();
+}
+
 void CanSchedule::cycle(Stamp t, const Heartbeat& heartbeat) {
   buf_.clear();
   buf_.push_back(encoder_.encode_heartbeat(heartbeat));

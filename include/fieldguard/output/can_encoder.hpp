@@ -73,6 +73,10 @@ class CanEncoder {
   [[nodiscard]] CanFrame encode_stop(const StopRequest& request);
   [[nodiscard]] CanFrame encode_heartbeat(const Heartbeat& heartbeat);
 
+  // New parameters (a configuration reload), the alive counters going on where they were: the controller sees
+  // one sequence whatever the daemon does. Throws std::invalid_argument as the constructor does.
+  void reconfigure(const CanParams& p);
+
   [[nodiscard]] std::uint32_t id_of(MessageId m) const { return ids_[static_cast<std::size_t>(m)]; }
   [[nodiscard]] std::uint64_t saturated_values() const { return saturated_; }
   [[nodiscard]] const CanParams& params() const { return params_; }

@@ -29,6 +29,10 @@ class CanSchedule {
   // at `t` at once, and repeated by the following cycles until the next frame or stop() replaces it.
   void stop(const StopRequest& stop, Stamp t);
 
+  // A new period (a configuration reload) from the next cycle on; the cycle due keeps its time. Throws
+  // std::invalid_argument for a period <= 0.
+  void set_period(Nanos period);
+
   [[nodiscard]] std::uint64_t skipped_cycles() const { return skipped_; }
   [[nodiscard]] const std::optional<StopRequest>& last_stop() const { return last_stop_; }
 
