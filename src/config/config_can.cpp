@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <filesystem>
+#include <type_traits>
 
 #include "config/section_readers.hpp"
 #include "fieldguard/output/can_sink.hpp"
@@ -31,13 +32,58 @@ void read_address(YamlReader& r, const YAML::Node& n, const std::string& path, c
   out = static_cast<std::uint8_t>(value);
 }
 
+// can.j1939: the NAME's fields each in its bits, the controller's NAME as 16 hex digits.
+void read_j1939(YamlReader& r, const YAML::Node& n, J1939Config& c) {
+  const std::string path = "can.j1939";
+  if (!r.section(n, path,
+                 {"address_claim", "arbitrary_address", "identity_number", "manufacturer_code", "function",
+                  "function_instance", "ecu_instance", "vehicle_system", "vehicle_system_instance", "industry_group",
+                  "controller_name", "component_id"})) {
+    return;
+  }
+  if (auto v = r.choice(n, path, "address_claim", {"false", "true"})) c.address_claim = *v == 1;
+  if (auto v = r.choice(n, path, "arbitrary_address", {"false", "true"})) c.name.arbitrary_address_capable = *v == 1;
+  auto field = [&](const char* key, auto& out, int hi) {
+    int v = static_cast<int>(out);
+    r.integer(n, path, key, v, 0, hi);
+    out = static_cast<std::remove_reference_t<decltype(out)>>(v);
+  };
+  field("identity_number", c.name.identity_number, (1 << 21) - 1);
+  field("manufacturer_code", c.name.manufacturer_code, (1 << 11) - 1);
+  field("function", c.name.function, 255);
+  field("function_instance", c.name.function_instance, 31);
+  field("ecu_instance", c.name.ecu_instance, 7);
+  field("vehicle_system", c.name.vehicle_system, 127);
+  field("vehicle_system_instance", c.name.vehicle_system_instance, 15);
+  field("industry_group", c.name.industry_group, 7);
+  std::string controller;
+  r.text(n, path, "controller_name", controller);
+  if (!controller.empty()) {
+    const bool hex = controller.size() > 2 && controller[0] == '0' && (controller[1] == 'x' || controller[1] == 'X');
+    std::uint64_t v = 0;
+    const char* begin = controller.data() + (hex ? 2 : 0);
+    const char* end = controller.data() + controller.size();
+    const auto [ptr, ec] = std::from_chars(begin, end, v, 16);
+    if (!hex || ec != std::errc() || ptr != end) {
+      r.issue(n["controller_name"], path + ".controller_name",
+              "expected the controller's 64-bit NAME in hex as `inspect` prints it (0x...), got '" + controller + "'");
+    } else {
+      c.controller_name = v;
+    }
+  }
+  r.text(n, path, "component_id", c.component_id);
+  if (c.component_id.size() + 1 > output::j1939::kMaxTransportBytes) {
+    r.issue(n["component_id"], path + ".component_id", "longer than one J1939 transport message (1784 characters)");
+  }
+}
+
 }  // namespace
 
 void read_can(YamlReader& r, const YAML::Node& n, const std::string& config_dir, CanConfig& c) {
   const std::string path = "can";
   if (!r.section(n, path,
                  {"sink", "interface", "log_path", "source_address", "controller_address", "max_obstacles",
-                  "heartbeat_period_s", "speed", "speed_timeout_s"})) {
+                  "heartbeat_period_s", "speed", "speed_timeout_s", "j1939"})) {
     return;
   }
   if (auto s = r.choice(n, path, "sink", {"socketcan", "candump", "none"})) {
@@ -55,6 +101,7 @@ void read_can(YamlReader& r, const YAML::Node& n, const std::string& config_dir,
     c.speed = *s == 0 ? SpeedInput::None : (*s == 1 ? SpeedInput::Ccvs1 : SpeedInput::IsoWheelBased);
   }
   r.number(n, path, "speed_timeout_s", c.speed_timeout_s, 0.05, 10.0, "s");
+  if (n.IsMap() && n["j1939"]) read_j1939(r, n["j1939"], c.j1939);
 
   if (const std::string bad = output::check_interface_name(c.interface); !bad.empty()) {
     r.issue(n.IsMap() && n["interface"] ? n["interface"] : n, "can.interface", bad);

@@ -113,6 +113,61 @@ TEST(ConfigOutput, SpeedFromTheBus) {
   EXPECT_TRUE(has_issue(bad, "can.speed_timeout_s", "", 3)) << dump(bad);
 }
 
+TEST(ConfigOutput, TheJ1939NodeAndItsName) {
+  const auto d = load_config_text("can: {sink: none}\n", "d.yaml");
+  ASSERT_TRUE(d.ok()) << dump(d);
+  EXPECT_TRUE(d.config.can.j1939.address_claim);
+  EXPECT_TRUE(d.config.can.j1939.name.arbitrary_address_capable);
+  EXPECT_EQ(d.config.can.j1939.name.industry_group, 2);
+  EXPECT_EQ(d.config.can.j1939.name.function, 255);
+  EXPECT_FALSE(d.config.can.j1939.controller_name);
+  const auto r = load_config_text(R"(can:
+  j1939:
+    address_claim: false
+    arbitrary_address: false
+    identity_number: 2097151
+    manufacturer_code: 1234
+    function: 130
+    function_instance: 31
+    ecu_instance: 7
+    vehicle_system: 127
+    vehicle_system_instance: 15
+    industry_group: 2
+    controller_name: 0xA00C8100AB3C0042
+    component_id: fieldguard*FG-1*0042*7*
+)",
+                                  "j.yaml");
+  ASSERT_TRUE(r.ok()) << dump(r);
+  const auto& j = r.config.can.j1939;
+  EXPECT_FALSE(j.address_claim);
+  EXPECT_FALSE(j.name.arbitrary_address_capable);
+  EXPECT_EQ(j.name.identity_number, 2097151U);
+  EXPECT_EQ(j.name.manufacturer_code, 1234);
+  EXPECT_EQ(j.name.function, 130);
+  EXPECT_EQ(j.name.function_instance, 31);
+  EXPECT_EQ(j.name.ecu_instance, 7);
+  EXPECT_EQ(j.name.vehicle_system, 127);
+  EXPECT_EQ(j.name.vehicle_system_instance, 15);
+  EXPECT_EQ(j.controller_name, 0xA00C8100AB3C0042ULL);
+  EXPECT_EQ(j.component_id, "fieldguard*FG-1*0042*7*");
+
+  const auto bad = load_config_text(R"(can:
+  j1939:
+    identity_number: 2097152
+    manufacturer_code: -1
+    industry_group: 8
+    controller_name: A00C8100AB3C0042
+    adress_claim: true
+)",
+                                    "b.yaml");
+  EXPECT_TRUE(has_issue(bad, "can.j1939.identity_number", "out of range", 3)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "can.j1939.manufacturer_code", "out of range", 4)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "can.j1939.industry_group", "out of range", 5)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "can.j1939.controller_name", "0x...", 6)) << dump(bad);
+  EXPECT_TRUE(has_issue(bad, "can.j1939.adress_claim", "", 7)) << dump(bad);
+  EXPECT_EQ(bad.issues.size(), 5U) << dump(bad);
+}
+
 TEST(ConfigRealtime, ReadsEveryKeyAndDefaultsToNormalScheduling) {
   const auto defaults = load_config_text("lidar: {data_port: 2368}\n", "d.yaml");
   ASSERT_TRUE(defaults.ok()) << dump(defaults);

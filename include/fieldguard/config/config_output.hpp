@@ -4,10 +4,12 @@
 // with defaults, filled and checked by the config loader (src/app/config_pipeline.cpp, config_can.cpp).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "fieldguard/output/can_encoder.hpp"
+#include "fieldguard/output/j1939.hpp"
 #include "fieldguard/sync/threads.hpp"
 
 namespace fieldguard::app {
@@ -39,6 +41,22 @@ enum class CanSinkKind : std::uint8_t { SocketCan, Candump, None };
 // The tractor's speed read off the bus (output/can_speed.hpp) to size the stop zone.
 enum class SpeedInput : std::uint8_t { None, Ccvs1, IsoWheelBased };
 
+// fieldguard as a J1939 / ISO 11783 node (`can.j1939`): its NAME, the address claim, the controller found by NAME.
+struct J1939Config {
+  bool address_claim = true;  // claim can.source_address before sending (J1939-81); false: send from it unclaimed
+  output::j1939::Name name = default_name();
+  std::optional<std::uint64_t> controller_name;  // the controller's address from its Address Claimed, when heard
+  std::string component_id;                      // Component Identification (PGN 65259): make*model*serial*unit*
+
+  static output::j1939::Name default_name() {
+    output::j1939::Name n;
+    n.function = 0xFF;  // "not available": the integrator assigns one
+    n.industry_group = output::j1939::kIndustryGroupAgricultural;
+    n.arbitrary_address_capable = true;
+    return n;
+  }
+};
+
 struct CanConfig {
   CanSinkKind sink = CanSinkKind::SocketCan;
   std::string interface = "can0";       // the SocketCAN interface; also the interface name written in a candump log
@@ -47,6 +65,7 @@ struct CanConfig {
   double heartbeat_period_s = 0.1;      // heartbeat (and repeated stop request) period
   SpeedInput speed = SpeedInput::None;  // read from `interface` (SocketCAN) by the daemon
   double speed_timeout_s = 0.5;         // an older speed is unknown: the zone has its full-speed length
+  J1939Config j1939;
 };
 
 }  // namespace fieldguard::app
