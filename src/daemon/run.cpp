@@ -21,6 +21,7 @@
 #include "fieldguard/core/alloc_count.hpp"
 #include "fieldguard/core/exit_code.hpp"
 #include "fieldguard/daemon/daemon.hpp"
+#include "fieldguard/engine/can_link.hpp"
 #include "fieldguard/engine/logging.hpp"
 #include "fieldguard/output/can_sink.hpp"
 #include "fieldguard/sync/threads.hpp"
@@ -95,6 +96,7 @@ class Daemon {
   SystemdNotifier notify_ = SystemdNotifier::from_environment();
   SinkKey key_;
   std::unique_ptr<output::CanSink> sink_;
+  std::unique_ptr<CanLink> link_;  // outlives the sessions: alive counters, the stop request's cycle, the address
   std::unique_ptr<Session> session_;
   bool ready_ = false;  // READY=1 sent, by any session of this process
   bool io_refusal_logged_ = false;
@@ -115,6 +117,7 @@ bool Daemon::open() {
   key_ = sink_key(loaded.config, opt_.can_log);
   try {
     sink_ = make_sink(key_);
+    link_ = std::make_unique<CanLink>(loaded.config.can, *sink_);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fieldguard run: CAN output: %s\n", e.what());
     return false;
@@ -154,7 +157,7 @@ void Daemon::apply_realtime(const RealtimeConfig& rt) {
 
 std::unique_ptr<Session> Daemon::open_session(const Config& cfg) {
   apply_realtime(cfg.realtime);
-  auto s = std::make_unique<Session>(io_, cfg, *sink_, notify_, ready_);
+  auto s = std::make_unique<Session>(io_, cfg, *link_, notify_, ready_);
   s->start();
   return s;
 }
@@ -188,15 +191,21 @@ void Daemon::reload() {
   session_.reset();
   try {
     if (!(new_key == key_)) {
+      // Another bus: a new node on it, whose counters and claim start afresh.
       auto s = make_sink(new_key);
+      auto l = std::make_unique<CanLink>(fresh.config.can, *s);
+      link_ = std::move(l);
       sink_ = std::move(s);
       key_ = new_key;
+    } else {
+      link_->reconfigure(fresh.config.can);
     }
     session_ = open_session(fresh.config);
     log_->info("reloaded {}: starting again from STOP, starting up", opt_.config);
   } catch (const std::exception& e) {
     log_->error("reload failed: {}; going back to the previous configuration", e.what());
     session_.reset();
+    if (key_ == sink_key(old, opt_.can_log)) link_->reconfigure(old.can);
     session_ = open_session(old);
   }
   notify_.reloaded(session_->status(wall_clock_now()));

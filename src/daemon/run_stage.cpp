@@ -18,11 +18,7 @@ bool same_request(const output::StopRequest& a, const output::StopRequest& b) {
          a.reasons.starting_up == b.reasons.starting_up && a.reasons.shutting_down == b.reasons.shutting_down;
 }
 
-LiveStage::LiveStage(const Config& cfg, output::CanSink& sink)
-    : cfg_(cfg),
-      encoder_(cfg.can.params),
-      schedule_(encoder_, sink, nanos_from_seconds(cfg.can.heartbeat_period_s)),
-      monitor_(cfg.safety) {}
+LiveStage::LiveStage(const Config& cfg, CanLink& link) : cfg_(cfg), link_(link), monitor_(cfg.safety) {}
 
 void LiveStage::sensor_data(safety::Sensor s, Stamp t) {
   auto& last = input_.sensors[static_cast<std::size_t>(s)].last_data;
@@ -52,8 +48,10 @@ void LiveStage::note(const safety::Decision& d, const char* what) {
 const safety::Decision& LiveStage::frame(const LidarFrame& f, const perception::FrameResult& result, Stamp data_end,
                                          Stamp now, std::uint64_t frames_lost) {
   // Cycles due before this decision go out first, with what was known then: the log stays in time order.
-  schedule_.tick(now, heartbeat(frames_lost));
+  link_.start(now);
+  link_.schedule().tick(now, heartbeat(frames_lost));
   input_.now = now;
+  input_.no_address = link_.no_address();
   safety::FrameInput frame_in;
   frame_in.obstacles = result.obstacles;
   frame_in.data_end = data_end;
@@ -63,6 +61,7 @@ const safety::Decision& LiveStage::frame(const LidarFrame& f, const perception::
   input_.frame = nullptr;
   for (auto& s : input_.sensors) s.problem = safety::Problem::None;
   const safety::Decision& d = *last_;
+  link_.decided(d, now);
   ++counts_.frames;
   ++(d.stop ? counts_.stop_frames : counts_.go_frames);
   if (d.event) note(d, ("rotation " + std::to_string(f.index)).c_str());  // the label only when there is news
@@ -71,35 +70,38 @@ const safety::Decision& LiveStage::frame(const LidarFrame& f, const perception::
   report.status = f.partial ? output::FrameStatus::PartialFrame : output::FrameStatus::Ok;
   report.obstacles = result.obstacles;
   sent_ = CanStage::request_for(d);
-  schedule_.frame(report, *sent_, now);
+  link_.schedule().frame(report, *sent_, now);
   return d;
 }
 
 const safety::Decision& LiveStage::tick(Stamp now, std::uint64_t frames_lost) {
-  schedule_.tick(now, heartbeat(frames_lost));
+  link_.start(now);  // the address claim, once in the link's life (Session::start ticks first)
+  link_.schedule().tick(now, heartbeat(frames_lost));
   input_.now = now;
   input_.frame = nullptr;
+  input_.no_address = link_.no_address();
   last_ = monitor_.update(input_);
   for (auto& s : input_.sensors) s.problem = safety::Problem::None;
   note(*last_, "between rotations");
+  link_.decided(*last_, now);
   // Before the first decision the schedule already repeats STOP, starting up; afterwards a change decided
   // between rotations (a timeout) must not wait for a rotation that may never come.
   const output::StopRequest request = CanStage::request_for(*last_);
   if (sent_ ? !same_request(*sent_, request)
             : request.command != output::StopCommand::Stop || !request.reasons.starting_up) {
     sent_ = request;
-    schedule_.stop(request, now);
+    link_.schedule().stop(request, now);
   }
   return *last_;
 }
 
 void LiveStage::shutdown(Stamp now) {
-  schedule_.tick(now, heartbeat(0));
+  link_.schedule().tick(now, heartbeat(0));
   output::StopRequest r;
   r.command = output::StopCommand::Stop;
   r.reasons.shutting_down = true;
   sent_ = r;
-  schedule_.stop(r, now);
+  link_.schedule().stop(r, now);
 }
 
 output::Heartbeat LiveStage::heartbeat(std::uint64_t frames_lost) const {

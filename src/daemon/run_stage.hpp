@@ -13,9 +13,8 @@
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/core/time.hpp"
+#include "fieldguard/engine/can_link.hpp"
 #include "fieldguard/output/can_encoder.hpp"
-#include "fieldguard/output/can_schedule.hpp"
-#include "fieldguard/output/can_sink.hpp"
 #include "fieldguard/output/safety_monitor.hpp"
 #include "fieldguard/perception/obstacle.hpp"
 
@@ -30,9 +29,9 @@ struct LiveStageCounts {
 
 class LiveStage {
  public:
-  // `cfg` and `sink` must outlive the stage. Throws std::invalid_argument for parameters the loader should
-  // have refused.
-  LiveStage(const Config& cfg, output::CanSink& sink);
+  // `cfg` and `link` must outlive the stage; the link (the encoder's counters, the schedule's cycle, the J1939
+  // node) outlives it across reloads. Throws std::invalid_argument for parameters the loader should have refused.
+  LiveStage(const Config& cfg, CanLink& link);
 
   // A sensor's data arrived at host time `t` (the 3D LiDAR: every datagram).
   void sensor_data(output::safety::Sensor s, Stamp t);
@@ -53,6 +52,7 @@ class LiveStage {
 
   [[nodiscard]] bool started() const { return monitor_.started(); }
   [[nodiscard]] const LiveStageCounts& counts() const { return counts_; }
+  [[nodiscard]] const CanLink& link() const { return link_; }
   [[nodiscard]] const std::optional<output::safety::Decision>& last_decision() const { return last_; }
 
  private:
@@ -60,8 +60,7 @@ class LiveStage {
   void note(const output::safety::Decision& d, const char* what);
 
   const Config& cfg_;
-  output::CanEncoder encoder_;
-  output::CanSchedule schedule_;
+  CanLink& link_;
   output::safety::Monitor monitor_;
   output::safety::Input input_;
   std::optional<output::safety::Decision> last_;

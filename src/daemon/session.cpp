@@ -35,12 +35,12 @@ sync::SensorKind kind_of(safety::Sensor s) {
 
 }  // namespace
 
-Session::Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink, SystemdNotifier& notify, bool& ready)
+Session::Session(boost::asio::io_context& io, Config cfg, CanLink& link, SystemdNotifier& notify, bool& ready)
     : io_(io),
       cfg_(std::move(cfg)),
       notify_(notify),
       ready_(ready),
-      stage_(cfg_, sink),
+      stage_(cfg_, link),
       fusion_(cfg_, FusionInputs::enabled_in(cfg_)),
       detectors_(cfg_, static_cast<std::size_t>(cfg_.pipeline.workers)),
       pool_(pool_params(cfg_, io, waker_), [this](FrameJob& j, DetectedFrame& d) { process(j, d); }),
@@ -244,6 +244,7 @@ void Session::print_summary() const {
   std::printf("  frames            %llu decided, %llu lost\n", u(c.frames), u(lost_));
   std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n", u(c.stop_frames), u(c.go_frames), u(c.changes));
   if (cfg_.perception.hold.enabled) std::printf("  held obstacles    %llu (from fragments)\n", u(held_));
+  std::printf("  j1939             %s\n", j1939_summary(stage_.link()).c_str());
   std::printf(
       "  pool              %llu submitted, %llu dropped, %llu refused, %llu failed; after bursts %llu slots and %llu "
       "spare buffers gave their memory back\n",

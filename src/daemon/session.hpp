@@ -44,7 +44,7 @@ class Session {
 
  public:
   // `ready`: READY=1 was sent (by this process, for any session): the watchdog is fed only from then on.
-  Session(boost::asio::io_context& io, Config cfg, output::CanSink& sink, SystemdNotifier& notify, bool& ready);
+  Session(boost::asio::io_context& io, Config cfg, CanLink& link, SystemdNotifier& notify, bool& ready);
   Session(const Session&) = delete;
   Session& operator=(const Session&) = delete;
   Session(Session&&) = delete;

@@ -12,13 +12,14 @@ namespace safety = output::safety;
 
 }  // namespace
 
-CanStage::CanStage(const Config& cfg, output::CanSink& sink)
-    : cfg_(cfg),
-      encoder_(cfg.can.params),
-      schedule_(encoder_, sink, nanos_from_seconds(cfg.can.heartbeat_period_s)),
-      monitor_(cfg.safety) {}
+CanStage::CanStage(const Config& cfg, output::CanSink& sink) : cfg_(cfg), link_(cfg.can, sink), monitor_(cfg.safety) {}
 
-void CanStage::start(Stamp t) { schedule_.tick(t, heartbeat(0)); }
+void CanStage::start(Stamp t) {
+  // The claim one hold time before the capture's first data, as a daemon started before its sensors has claimed
+  // its address by the time they speak: every decision of the capture reaches the log.
+  link_.start(Stamp{t.ns - nanos_from_seconds(output::j1939::ClaimParams{}.hold_s).count()});
+  link_.schedule().tick(t, heartbeat(0));
+}
 
 void CanStage::sensor_data(safety::Sensor s, Stamp t) { input_.sensors[static_cast<std::size_t>(s)].last_data = t; }
 
@@ -27,7 +28,10 @@ void CanStage::sensor_problem(safety::Sensor s, safety::Problem p) {
   if (slot == safety::Problem::None) slot = p;
 }
 
-void CanStage::tick(Stamp now, std::uint64_t frames_lost) { schedule_.tick(now, heartbeat(frames_lost)); }
+void CanStage::tick(Stamp now, std::uint64_t frames_lost) {
+  link_.schedule().tick(now, heartbeat(frames_lost));
+  link_.advance(now);
+}
 
 output::StopRequest CanStage::request_for(const safety::Decision& d) {
   output::StopRequest r;
@@ -67,8 +71,9 @@ output::Heartbeat CanStage::heartbeat_for(const safety::Params& safety, const st
 void CanStage::frame(const LidarFrame& f, const perception::FrameResult& result, Stamp complete,
                      std::uint64_t frames_lost) {
   // Heartbeats due before this decision go out first, with what was known then: the log stays in time order.
-  schedule_.tick(complete, heartbeat(frames_lost));
+  link_.schedule().tick(complete, heartbeat(frames_lost));
   input_.now = complete;
+  input_.no_address = link_.no_address();
   input_.sensors[static_cast<std::size_t>(safety::Sensor::Lidar)].last_data = complete;
   safety::FrameInput frame_in;
   frame_in.obstacles = result.obstacles;
@@ -79,6 +84,7 @@ void CanStage::frame(const LidarFrame& f, const perception::FrameResult& result,
   for (auto& s : input_.sensors) s.problem = safety::Problem::None;
 
   const safety::Decision& d = *last_;
+  link_.decided(d, complete);
   if (d.stop) {
     ++counts_.stop_frames;
   } else {
@@ -92,7 +98,7 @@ void CanStage::frame(const LidarFrame& f, const perception::FrameResult& result,
   report.frame_counter = static_cast<std::uint32_t>(f.index);
   report.status = f.partial ? output::FrameStatus::PartialFrame : output::FrameStatus::Ok;
   report.obstacles = result.obstacles;
-  schedule_.frame(report, request_for(d), complete);
+  link_.schedule().frame(report, request_for(d), complete);
 }
 
 }  // namespace fieldguard::app

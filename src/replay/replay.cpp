@@ -554,6 +554,7 @@ int Replay::finish() {
                 static_cast<unsigned long long>(cc.stop_frames), static_cast<unsigned long long>(cc.go_frames),
                 static_cast<unsigned long long>(cc.changes));
     std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log_->stats().sent));
+    std::printf("  j1939             %s\n", j1939_summary(can_->link()).c_str());
   }
   print_fusion_summary();
   if (samples_) samples_->finish();

@@ -31,6 +31,7 @@
 #include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/geo/projection.hpp"
 #include "fieldguard/io/byte_log.hpp"
+#include "fieldguard/output/diagnostics.hpp"
 #include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/writers/obstacles_jsonl.hpp"
@@ -357,10 +358,17 @@ TEST_F(ReplayFusion, FixedPoleStaysWithin5cmOnThePlaneOver100Frames) {
   EXPECT_GT(worst_raw, 3.0 * worst);
 }
 // The stop requests of a `replay --session DIR --can-log` run: (stamp us, sensor fault reason) of each STOP.
+struct Dm1 {
+  long long us = 0;  // the stamp of its frame (one frame) or of its last packet (BAM)
+  std::vector<output::j1939::Dtc> dtcs;
+  output::j1939::Lamps lamps;
+};
 struct StopLog {
   std::vector<long long> sensor_fault_us;  // stamps of stop requests giving a sensor fault
   std::size_t stops = 0;
   std::size_t frames = 0;
+  std::uint32_t first_id = 0;  // of the log's first frame
+  std::vector<Dm1> dm1;        // every DM1 in the log, as sent
 };
 StopLog replay_stops(const std::string& session_dir, const std::string& work) {
   const std::string config = std::string(FIELDGUARD_TEST_DATA) + "/fusion/uneven-drive.yaml";
@@ -372,7 +380,24 @@ StopLog replay_stops(const std::string& session_dir, const std::string& work) {
   const auto& stop = db.by_name("FG_STOP_REQUEST");
   const auto& summary = db.by_name("FG_OBSTACLE_SUMMARY");
   StopLog out;
+  output::j1939::BamReceiver bam;
   for (const auto& f : testing::read_candump(testing::slurp(log))) {
+    if (out.first_id == 0) out.first_id = f.id;
+    if (testing::is_node_frame(f.id)) {
+      output::CanFrame frame{f.id, static_cast<std::uint8_t>(f.data.size()), {}};
+      std::copy(f.data.begin(), f.data.end(), frame.data.begin());
+      std::optional<std::vector<std::uint8_t>> dm1;
+      if (output::j1939_fields(f.id).pgn == output::j1939::kPgnDm1) dm1 = f.data;
+      if (auto m = bam.feed(frame, static_cast<double>(f.us) * 1e-6); m && m->pgn == output::j1939::kPgnDm1) {
+        dm1 = m->data;
+      }
+      if (dm1) {
+        auto d = output::j1939::decode_diagnostic(*dm1);
+        EXPECT_TRUE(d.has_value()) << "a DM1 that does not decode at " << f.us;
+        if (d) out.dm1.push_back({f.us, d->dtcs, d->lamps});
+      }
+      continue;
+    }
     const auto* m = db.by_can_id(f.id);
     if (m == &summary) ++out.frames;
     if (m != &stop) continue;
@@ -437,6 +462,29 @@ TEST_F(ReplayFusion, AGnssPositionJumpStopsTheTractorAsASensorFault) {
   std::printf("GNSS position jump (GGA %d): STOP, sensor fault, decided %.3f s after it arrived\n",
               gga >= 80 ? 80 : gga, static_cast<double>(*first - jump_us) * 1e-6);
   EXPECT_LE(*first - jump_us, 600'000);
+
+  // On the bus as a J1939 node (issue 27): the log begins with our Address Claimed; the jump is DM1's DTC
+  // SPN 520194 (GNSS) FMI 2 (erratic) within a second, and a DM1 without it (lamps off) once it has passed.
+  EXPECT_EQ(jumped.first_id, 0x18EEFF80U) << std::hex << jumped.first_id;
+  EXPECT_EQ(clean.first_id, 0x18EEFF80U) << std::hex << clean.first_id;
+  ASSERT_GT(clean.dm1.size(), 10U) << "DM1 once a second";
+  const auto gnss_erratic = [](const Dm1& d) {
+    return std::any_of(d.dtcs.begin(), d.dtcs.end(), [](const output::j1939::Dtc& c) {
+      return c.spn == output::j1939::sensor_spn(output::safety::Sensor::Gnss) && c.fmi == 2;
+    });
+  };
+  EXPECT_TRUE(std::none_of(clean.dm1.begin(), clean.dm1.end(), gnss_erratic)) << "a DTC in the clean session";
+  const auto raised = std::find_if(jumped.dm1.begin(), jumped.dm1.end(),
+                                   [&](const Dm1& d) { return d.us >= jump_us && gnss_erratic(d); });
+  ASSERT_NE(raised, jumped.dm1.end()) << "no DM1 with the GNSS's DTC after the jump";
+  EXPECT_LE(raised->us - jump_us, 1'000'000);
+  EXPECT_EQ(raised->lamps.amber_warning, output::j1939::Lamp::On);
+  EXPECT_EQ(raised->dtcs.front().occurrences, 1);
+  const auto cleared = std::find_if(raised, jumped.dm1.end(), [](const Dm1& d) { return d.dtcs.empty(); });
+  ASSERT_NE(cleared, jumped.dm1.end()) << "the DTC never cleared";
+  EXPECT_EQ(cleared->lamps.amber_warning, output::j1939::Lamp::Off);
+  std::printf("DM1: GNSS erratic (520194/2) %.3f s after the jump, cleared %.3f s after that\n",
+              static_cast<double>(raised->us - jump_us) * 1e-6, static_cast<double>(cleared->us - raised->us) * 1e-6);
 }
 
 // The last 20 frames (4 s; the tractor has stopped 1 m short of the box) of a replay's obstacles.

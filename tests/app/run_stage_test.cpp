@@ -31,9 +31,18 @@ class RecordingSink final : public output::CanSink {
   output::CanSinkStats stats_;
 };
 
+// The defaults (the 3D LiDAR required, timeout 0.3 s, 3 clear frames, heartbeat 100 ms) without the address claim:
+// these tests are about the stop path from the first tick on (the claim's hold is CanLink's tests').
+Config unclaimed() {
+  Config c;
+  c.can.j1939.address_claim = false;
+  return c;
+}
+
 struct LiveStageTest : ::testing::Test {
-  Config cfg;  // defaults: the 3D LiDAR required, timeout 0.3 s, 3 clear frames, heartbeat 100 ms
+  Config cfg = unclaimed();
   RecordingSink sink;
+  CanLink link{cfg.can, sink};
   output::CanEncoder enc{cfg.can.params};
   const std::int64_t t0 = 1'700'000'000'000 * kMs;
 
@@ -50,7 +59,7 @@ struct LiveStageTest : ::testing::Test {
 };
 
 TEST_F(LiveStageTest, SilenceAfterGoStopsAtTheTimeoutWithoutARotation) {
-  LiveStage stage(cfg, sink);
+  LiveStage stage(cfg, link);
   stage.tick(Stamp{t0}, 0);
   ASSERT_FALSE(stops().empty());
   EXPECT_EQ(sig(stops().back(), output::stop_sig::Command), 1U);
@@ -105,7 +114,7 @@ TEST_F(LiveStageTest, AFreshBusSpeedSizesTheZoneAStaleOneDoesNot) {
   const double slow = cfg.safety.zone.front_x_m + output::safety::zone_length_m(cfg.safety.zone, 1.0);
   ASSERT_GT(full, 10.5);
   ASSERT_LT(slow, 9.5);
-  LiveStage stage(cfg, sink);
+  LiveStage stage(cfg, link);
   perception::FrameResult ahead;
   perception::Obstacle o;
   o.min = {9.8F, -0.2F, -0.9F};
@@ -148,7 +157,7 @@ TEST_F(LiveStageTest, AFreshBusSpeedSizesTheZoneAStaleOneDoesNot) {
 
 // What the daemon hands the hold (obstacle_hold.hpp) and the zone: the bus's speed while fresh, then unknown.
 TEST_F(LiveStageTest, SpeedAtIsTheBusSpeedWithinItsTimeout) {
-  LiveStage stage(cfg, sink);
+  LiveStage stage(cfg, link);
   EXPECT_FALSE(stage.speed_at(Stamp{t0}).has_value()) << "no speed heard yet";
   stage.vehicle_speed(2.5, Stamp{t0});
   const auto timeout = static_cast<std::int64_t>(cfg.can.speed_timeout_s * 1e9);

@@ -38,10 +38,12 @@ TEST(SessionWake, AFinishedFrameIsDecidedWithoutAnyTimer) {
   cfg.lidar.data_port = 0;  // the kernel chooses
   cfg.pipeline.workers = 2;
   boost::asio::io_context io;
+  cfg.can.j1939.address_claim = false;  // the STOP of start-up at once, not after the claim's 250 ms
   RecordingSink sink;
+  CanLink link(cfg.can, sink);
   SystemdNotifier notify = SystemdNotifier::from_environment();
   bool ready = false;
-  Session session(io, cfg, sink, notify, ready);
+  Session session(io, cfg, link, notify, ready);
   session.start();
   const output::CanEncoder enc(cfg.can.params);
   const auto stop_requests = [&] {

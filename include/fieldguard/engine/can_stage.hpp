@@ -10,8 +10,8 @@
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/core/time.hpp"
+#include "fieldguard/engine/can_link.hpp"
 #include "fieldguard/output/can_encoder.hpp"
-#include "fieldguard/output/can_schedule.hpp"
 #include "fieldguard/output/can_sink.hpp"
 #include "fieldguard/output/safety_monitor.hpp"
 #include "fieldguard/perception/obstacle.hpp"
@@ -29,8 +29,8 @@ class CanStage {
   // `sink` must outlive the stage. Throws std::invalid_argument for parameters the loader should have refused.
   CanStage(const Config& cfg, output::CanSink& sink);
 
-  // The first data at `t`: the heartbeat clock starts; until the first rotation is decided the stop request
-  // says STOP, starting up.
+  // The first data at `t`: the heartbeat clock starts, the address claim (can.j1939) stamped 250 ms (its hold)
+  // before; until the first rotation is decided the stop request says STOP, starting up.
   void start(Stamp t);
   // One rotation, decided at `complete` (when its last packet was in hand, which is also the 3D LiDAR's newest
   // receive time); the other sensors count as never heard unless given with sensor_data().
@@ -45,6 +45,7 @@ class CanStage {
 
   [[nodiscard]] const CanStageCounts& counts() const { return counts_; }
   [[nodiscard]] const std::optional<output::safety::Decision>& last_decision() const { return last_; }
+  [[nodiscard]] const CanLink& link() const { return link_; }
 
   // The stop request for a decision: while a stop is held for clear frames its reason is the one that caused it.
   [[nodiscard]] static output::StopRequest request_for(const output::safety::Decision& d);
@@ -57,8 +58,7 @@ class CanStage {
   [[nodiscard]] output::Heartbeat heartbeat(std::uint64_t frames_lost) const;
 
   const Config& cfg_;
-  output::CanEncoder encoder_;
-  output::CanSchedule schedule_;
+  CanLink link_;
   output::safety::Monitor monitor_;
   output::safety::Input input_;
   std::optional<output::safety::Decision> last_;
