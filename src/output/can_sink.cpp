@@ -126,7 +126,7 @@ Expected<SocketCanSink, std::string> SocketCanSink::open(std::string_view iface)
     return Unexpected{"CAN interface " + name + ": " + errno_text(errno) + " (check `ip link show " + name +
                       "` and the configured interface name)"};
   }
-  // We only send: no data frames in, only the error classes the sink counts.
+  // No data frames in until listen() says which the J1939 node needs; the error classes the sink counts.
   if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, nullptr, 0) != 0) {
     return Unexpected{"CAN_RAW_FILTER on " + name + ": " + errno_text(errno)};
   }
@@ -159,15 +159,31 @@ SocketCanSink::~SocketCanSink() {
 }
 
 SocketCanSink::SocketCanSink(SocketCanSink&& other) noexcept
-    : fd_(std::exchange(other.fd_, -1)), stats_(other.stats_) {}
+    : fd_(std::exchange(other.fd_, -1)), stats_(other.stats_), received_(std::move(other.received_)) {}
 
 SocketCanSink& SocketCanSink::operator=(SocketCanSink&& other) noexcept {
   if (this != &other) {
     if (fd_ >= 0) ::close(fd_);
     fd_ = std::exchange(other.fd_, -1);
     stats_ = other.stats_;
+    received_ = std::move(other.received_);
   }
   return *this;
+}
+
+bool SocketCanSink::listen(std::uint8_t own_address) {
+  constexpr canid_t kPf = 0x00FF0000U;  // the PDU format byte: the PGN of a PDU1 message without its destination
+  const can_filter filters[] = {
+      {CAN_EFF_FLAG | 0x00EA0000U, CAN_EFF_FLAG | CAN_RTR_FLAG | kPf},    // Request
+      {CAN_EFF_FLAG | 0x00EE0000U, CAN_EFF_FLAG | CAN_RTR_FLAG | kPf},    // Address Claimed, Cannot Claim
+      {CAN_EFF_FLAG | own_address, CAN_EFF_FLAG | CAN_RTR_FLAG | 0xFFU},  // anything from our address
+  };
+  return ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, filters, sizeof filters) == 0;
+}
+
+void SocketCanSink::take_received(std::vector<CanFrame>& out) {
+  out.clear();
+  out.swap(received_);
 }
 
 SocketCanSink::SendResult SocketCanSink::send(const CanFrame& f) {
@@ -194,11 +210,11 @@ SocketCanSink::SendResult SocketCanSink::send(const CanFrame& f) {
 }
 
 void SocketCanSink::write(std::span<const CanFrame> frames, Stamp /*t*/) {
-  poll_errors();
+  poll();
   for (const CanFrame& f : frames) (void)send(f);
 }
 
-void SocketCanSink::poll_errors() {
+void SocketCanSink::poll() {
   for (;;) {
     can_frame cf{};
     const ssize_t n = ::recv(fd_, &cf, sizeof cf, MSG_DONTWAIT);
@@ -207,8 +223,25 @@ void SocketCanSink::poll_errors() {
       return;  // EAGAIN: nothing waiting; anything else shows up again on send
     }
     if (n == 0) return;  // the socketpair peer closed (tests); a CAN socket never reads 0
-    if (n != static_cast<ssize_t>(sizeof cf) || (cf.can_id & CAN_ERR_FLAG) == 0) {
+    if (n != static_cast<ssize_t>(sizeof cf)) {
       ++stats_.unexpected_reads;
+      continue;
+    }
+    if ((cf.can_id & CAN_ERR_FLAG) == 0) {
+      if ((cf.can_id & CAN_EFF_FLAG) == 0 || (cf.can_id & CAN_RTR_FLAG) != 0 || cf.len > CAN_MAX_DLEN) {
+        ++stats_.unexpected_reads;
+        continue;
+      }
+      if (received_.size() >= kMaxReceived) {
+        ++stats_.received_dropped;
+        continue;
+      }
+      CanFrame f;
+      f.id = cf.can_id & CAN_EFF_MASK;
+      f.len = cf.len;
+      std::memcpy(f.data.data(), cf.data, cf.len);
+      received_.push_back(f);
+      ++stats_.received;
       continue;
     }
     ++stats_.error_frames;

@@ -256,7 +256,7 @@ TEST(SocketCanSink, BusOffFromErrorFramesIsReported) {
   Pair p(SOCK_SEQPACKET);
   ASSERT_GE(p.ours, 0);
   SocketCanSink sink(p.ours);
-  sink.poll_errors();  // nothing waiting: returns at once
+  sink.poll();  // nothing waiting: returns at once
   EXPECT_FALSE(sink.stats().bus_off);
   can_frame err{};
   err.can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;
@@ -266,17 +266,56 @@ TEST(SocketCanSink, BusOffFromErrorFramesIsReported) {
   data.can_id = 0x123;
   ASSERT_EQ(::send(p.theirs, &data, sizeof data, 0), static_cast<ssize_t>(sizeof data));
   ASSERT_EQ(::send(p.theirs, "xyz", 3, 0), 3);
-  sink.poll_errors();
+  sink.poll();
   EXPECT_TRUE(sink.stats().bus_off);
   EXPECT_EQ(sink.stats().bus_off_events, 1U);
   EXPECT_EQ(sink.stats().error_frames, 1U);
   EXPECT_EQ(sink.stats().unexpected_reads, 2U);
   err.can_id = CAN_ERR_FLAG | CAN_ERR_RESTARTED;
   ASSERT_EQ(::send(p.theirs, &err, sizeof err, 0), static_cast<ssize_t>(sizeof err));
-  sink.poll_errors();
+  sink.poll();
   EXPECT_FALSE(sink.stats().bus_off);
   EXPECT_EQ(sink.stats().restarts, 1U);
   EXPECT_EQ(sink.stats().error_frames, 2U);
+}
+
+TEST(SocketCanSink, ExtendedDataFramesAreKeptForTheNodeBoundedAndInOrder) {
+  Pair p(SOCK_SEQPACKET);
+  ASSERT_GE(p.ours, 0);
+  SocketCanSink sink(p.ours);
+  EXPECT_FALSE(sink.listen(0x80)) << "a socketpair takes no CAN filter: refused, not fatal";
+  can_frame request{};
+  request.can_id = CAN_EFF_FLAG | 0x18EA8026U;  // a Request to 0x80 from 0x26
+  request.len = 3;
+  request.data[0] = 0xDA;
+  request.data[1] = 0xFE;
+  ASSERT_EQ(::send(p.theirs, &request, sizeof request, 0), static_cast<ssize_t>(sizeof request));
+  can_frame remote{};
+  remote.can_id = CAN_EFF_FLAG | CAN_RTR_FLAG | 0x18EA8026U;
+  ASSERT_EQ(::send(p.theirs, &remote, sizeof remote, 0), static_cast<ssize_t>(sizeof remote));
+  // Received between our writes: write() polls, and keeps the frame for the node.
+  const CanFrame ours = frame(0x18FF1280, {1});
+  sink.write(std::span(&ours, 1), Stamp{});
+  std::vector<CanFrame> got;
+  sink.take_received(got);
+  ASSERT_EQ(got.size(), 1U);
+  EXPECT_EQ(got[0].id, 0x18EA8026U);
+  EXPECT_EQ(got[0].len, 3);
+  EXPECT_EQ(got[0].data[1], 0xFE);
+  EXPECT_EQ(sink.stats().unexpected_reads, 1U) << "the remote frame";
+  sink.take_received(got);
+  EXPECT_TRUE(got.empty());
+  for (std::size_t i = 0; i < SocketCanSink::kMaxReceived + 10; ++i) {
+    request.data[2] = static_cast<std::uint8_t>(i);
+    ASSERT_EQ(::send(p.theirs, &request, sizeof request, 0), static_cast<ssize_t>(sizeof request));
+    if (i % 50 == 49) sink.poll();  // the socket buffer is smaller than the backlog
+  }
+  sink.poll();
+  sink.take_received(got);
+  ASSERT_EQ(got.size(), SocketCanSink::kMaxReceived);
+  EXPECT_EQ(got.front().data[2], 0) << "the oldest kept";
+  EXPECT_EQ(sink.stats().received_dropped, 10U);
+  EXPECT_EQ(sink.stats().received, SocketCanSink::kMaxReceived + 1);
 }
 
 TEST(SocketCanSink, MovesKeepOneOwner) {

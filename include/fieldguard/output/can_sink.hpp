@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "fieldguard/core/expected.hpp"
 #include "fieldguard/core/time.hpp"
@@ -33,7 +34,9 @@ struct CanSinkStats {
   std::uint64_t error_frames = 0;  // CAN_ERR_FLAG frames read back from the socket
   std::uint64_t bus_off_events = 0;
   std::uint64_t restarts = 0;
-  std::uint64_t unexpected_reads = 0;  // data frames or odd sizes the filters should have kept away
+  std::uint64_t unexpected_reads = 0;  // 11-bit or remote frames, odd sizes: what the filters should have kept away
+  std::uint64_t received = 0;          // extended data frames read for the J1939 node (SocketCanSink::take_received)
+  std::uint64_t received_dropped = 0;  // more than kMaxReceived waiting: the oldest kept, the rest counted
   bool bus_off = false;                // since the last CAN_ERR_BUSOFF, until CAN_ERR_RESTARTED
 };
 
@@ -77,9 +80,9 @@ class CandumpLogSink final : public CanSink {
 
 class SocketCanSink final : public CanSink {
  public:
-  // A CAN_RAW socket bound to `iface`, non-blocking, receiving only error frames (bus-off, controller
-  // problems, restarts). The error says what failed and what to do (no SocketCAN in the kernel, no such
-  // interface, ...).
+  // A CAN_RAW socket bound to `iface`, non-blocking, receiving error frames (bus-off, controller problems,
+  // restarts) and what the J1939 node must hear (listen()): requests, Address Claimed, frames from our address. The
+  // error says what failed and what to do (no SocketCAN in the kernel, no such interface, ...).
   [[nodiscard]] static Expected<SocketCanSink, std::string> open(std::string_view iface);
 
   // Adopts `fd` (a CAN_RAW socket, or in tests one end of a socketpair carrying struct can_frame) and makes
@@ -94,10 +97,19 @@ class SocketCanSink final : public CanSink {
   enum class SendResult : std::uint8_t { Sent, Dropped, Failed };
   // Never blocks.
   SendResult send(const CanFrame& f);
-  // poll_errors(), then send() each frame; `t` is unused (the kernel stamps what goes on the bus).
+  // poll(), then send() each frame; `t` is unused (the kernel stamps what goes on the bus).
   void write(std::span<const CanFrame> frames, Stamp t) override;
-  // Reads what is waiting (never blocks) and counts error frames.
-  void poll_errors();
+  // Reads what is waiting (never blocks): error frames counted, extended data frames kept for take_received().
+  void poll();
+  // The data frames poll() kept, oldest first, in `out` (cleared first). The sink never hands them to anyone
+  // itself: write() polls too, and the J1939 node must not be entered while it is writing.
+  void take_received(std::vector<CanFrame>& out);
+  // The kernel's filters for the J1939 node: Request (PGN 59904) and Address Claimed (60928) from anyone, and any
+  // frame from `own_address` (another node using it: an address violation). Call again when the address moves.
+  // Our own frames never come back: CAN_RAW does not echo a socket's frames to itself. False when refused.
+  bool listen(std::uint8_t own_address);
+
+  static constexpr std::size_t kMaxReceived = 256;
 
   [[nodiscard]] const CanSinkStats& stats() const override { return stats_; }
   [[nodiscard]] int fd() const { return fd_; }
@@ -105,6 +117,7 @@ class SocketCanSink final : public CanSink {
  private:
   int fd_ = -1;
   CanSinkStats stats_;
+  std::vector<CanFrame> received_;
 };
 
 }  // namespace fieldguard::output
