@@ -11,10 +11,12 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "daemon/bus_listener.hpp"
 #include "daemon/session.hpp"
 #include "daemon/systemd_notify.hpp"
 #include "fieldguard/config/config.hpp"
@@ -83,6 +85,8 @@ class Daemon {
 
  private:
   std::unique_ptr<Session> open_session(const Config& cfg);
+  void set_link(std::unique_ptr<output::CanSink> sink, const Config& cfg);
+  void listen_if_node();
   void apply_realtime(const RealtimeConfig& rt);
   void arm_timer();
   void wait_signal();
@@ -97,6 +101,8 @@ class Daemon {
   SinkKey key_;
   std::unique_ptr<output::CanSink> sink_;
   std::unique_ptr<CanLink> link_;  // outlives the sessions: alive counters, the stop request's cycle, the address
+  std::unique_ptr<BusListener> listener_;  // on a SocketCAN bus: what the J1939 node hears
+  bool filter_problem_logged_ = false;
   std::unique_ptr<Session> session_;
   bool ready_ = false;  // READY=1 sent, by any session of this process
   bool io_refusal_logged_ = false;
@@ -116,8 +122,7 @@ bool Daemon::open() {
   }
   key_ = sink_key(loaded.config, opt_.can_log);
   try {
-    sink_ = make_sink(key_);
-    link_ = std::make_unique<CanLink>(loaded.config.can, *sink_);
+    set_link(make_sink(key_), loaded.config);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fieldguard run: CAN output: %s\n", e.what());
     return false;
@@ -162,10 +167,38 @@ std::unique_ptr<Session> Daemon::open_session(const Config& cfg) {
   return s;
 }
 
+// A new sink and the link on it; on a SocketCAN bus the node hears requests and claims through the sink's socket.
+void Daemon::set_link(std::unique_ptr<output::CanSink> sink, const Config& cfg) {
+  auto link = std::make_unique<CanLink>(cfg.can, *sink);
+  listener_.reset();
+  link_ = std::move(link);
+  sink_ = std::move(sink);
+  listen_if_node();
+}
+
+// The listener once there is a node on a SocketCAN bus (also after a reload turned address_claim on).
+void Daemon::listen_if_node() {
+  auto* socket = dynamic_cast<output::SocketCanSink*>(sink_.get());
+  if (listener_ || socket == nullptr || link_->node() == nullptr) return;
+  try {
+    listener_ = std::make_unique<BusListener>(io_, *socket, *link_);
+  } catch (const std::exception& e) {
+    log_->warn("J1939: {}; requests and claims from the bus go unheard", e.what());
+  }
+}
+
 void Daemon::arm_timer() {
   timer_.expires_after(kTick);
   timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec) return;
+    if (listener_) {
+      listener_->on_bus();  // what a write() read meanwhile
+      if (!listener_->filter_problem().empty() && !filter_problem_logged_) {
+        filter_problem_logged_ = true;
+        log_->warn("J1939: the CAN socket refused its filters ({}); requests and claims go unheard",
+                   listener_->filter_problem());
+      }
+    }
     session_->on_tick(std::chrono::steady_clock::now() - timer_.expiry());
     arm_timer();
   });
@@ -192,13 +225,11 @@ void Daemon::reload() {
   try {
     if (!(new_key == key_)) {
       // Another bus: a new node on it, whose counters and claim start afresh.
-      auto s = make_sink(new_key);
-      auto l = std::make_unique<CanLink>(fresh.config.can, *s);
-      link_ = std::move(l);
-      sink_ = std::move(s);
+      set_link(make_sink(new_key), fresh.config);
       key_ = new_key;
     } else {
       link_->reconfigure(fresh.config.can);
+      listen_if_node();
     }
     session_ = open_session(fresh.config);
     log_->info("reloaded {}: starting again from STOP, starting up", opt_.config);
