@@ -151,6 +151,7 @@ std::vector<std::uint8_t> encode_diagnostic(const DiagnosticMessage& m) {
 
 Expected<DiagnosticMessage, DiagnosticError> decode_diagnostic(std::span<const std::uint8_t> data) {
   if (data.size() < 6) return Unexpected{DiagnosticError::TooShort};
+  if (data.size() > kMaxTransportBytes) return Unexpected{DiagnosticError::TooLong};
   DiagnosticMessage m;
   const std::uint8_t b = data[0];
   m.lamps = {static_cast<Lamp>(b >> 6U & 3U), static_cast<Lamp>(b >> 4U & 3U), static_cast<Lamp>(b >> 2U & 3U),
@@ -174,6 +175,7 @@ const char* to_string(DiagnosticError e) {
   switch (e) {
     case DiagnosticError::TooShort: return "shorter than lamps and one DTC";
     case DiagnosticError::Truncated: return "a partial DTC at the end";
+    case DiagnosticError::TooLong: return "longer than the transport protocol carries";
   }
   return "?";
 }

@@ -179,6 +179,13 @@ TEST(J1939Dm1, BadDataIsAnErrorNotAGuess) {
   EXPECT_EQ(decode_diagnostic(short5).error(), DiagnosticError::TooShort);
   const std::uint8_t partial[] = {0, 0xFF, 1, 2, 3, 4, 5, 6, 7};  // a DTC and three bytes that are not padding
   EXPECT_EQ(decode_diagnostic(partial).error(), DiagnosticError::Truncated);
+  // More than BAM carries cannot have come off a bus (and would not go back on it): refused (found by fuzz_j1939).
+  std::vector<std::uint8_t> huge(2 + 4 * 447, 0x01);
+  EXPECT_EQ(decode_diagnostic(huge).error(), DiagnosticError::TooLong);
+  huge.resize(1785);  // 445 DTCs and 3 bytes: within the size, so judged on its content
+  EXPECT_EQ(decode_diagnostic(huge).error(), DiagnosticError::Truncated);
+  huge.resize(1782);
+  EXPECT_EQ(decode_diagnostic(huge)->dtcs.size(), 445U);
 }
 
 TEST(J1939Bam, FramesOfOurOwnReassembleAndBrokenOnesAreCounted) {

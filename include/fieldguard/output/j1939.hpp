@@ -108,7 +108,8 @@ inline constexpr std::size_t kMaxDtcs = 445;  // (1785 - 2) / 4: what the transp
 // The data bytes (8 or more); throws std::invalid_argument for a field wider than its bits or more than kMaxDtcs.
 [[nodiscard]] std::vector<std::uint8_t> encode_diagnostic(const DiagnosticMessage& m);
 
-enum class DiagnosticError : std::uint8_t { TooShort, Truncated };  // under 6 bytes; a partial DTC (not 0xFF)
+// Under 6 bytes; a partial DTC (not 0xFF); longer than the transport protocol carries (1785 bytes).
+enum class DiagnosticError : std::uint8_t { TooShort, Truncated, TooLong };
 [[nodiscard]] Expected<DiagnosticMessage, DiagnosticError> decode_diagnostic(std::span<const std::uint8_t> data);
 [[nodiscard]] const char* to_string(DiagnosticError e);
 [[nodiscard]] const char* to_string(Lamp l);
