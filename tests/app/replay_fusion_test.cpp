@@ -19,6 +19,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -485,6 +486,32 @@ TEST_F(ReplayFusion, AGnssPositionJumpStopsTheTractorAsASensorFault) {
   EXPECT_EQ(cleared->lamps.amber_warning, output::j1939::Lamp::Off);
   std::printf("DM1: GNSS erratic (520194/2) %.3f s after the jump, cleared %.3f s after that\n",
               static_cast<double>(raised->us - jump_us) * 1e-6, static_cast<double>(cleared->us - raised->us) * 1e-6);
+
+  // The same log through python-can (Debian's python3-can) and a decoder written from the standards' layouts
+  // (tests/interop/j1939_read.py): our claim with its NAME, and every DM1, one-frame or BAM, the same.
+  const auto py = testing::run_shell("/usr/bin/python3 '" + std::string(FIELDGUARD_SOURCE_DIR) +
+                                     "/tests/interop/j1939_read.py' '" + (bad / "can.log").string() + "'");
+  ASSERT_EQ(py.exit_code, 0) << "python-can (tools/install-deps installs python3-can): " << py.output;
+  EXPECT_EQ(py.output.rfind("first 18EEFF80 extended\nclaim 80 name=", 0), 0U) << py.output;
+  EXPECT_NE(py.output.find("function=255 industry_group=2 arbitrary=1\n"), std::string::npos) << py.output;
+  std::string ours;
+  for (const auto& d : jumped.dm1) {
+    char lamps[3];
+    std::snprintf(lamps, sizeof lamps, "%02X", encode_diagnostic(output::j1939::DiagnosticMessage{d.lamps, {}})[0]);
+    std::string codes;
+    for (const auto& c : d.dtcs) {
+      codes += (codes.empty() ? "" : ",") + std::to_string(c.spn) + "/" + std::to_string(c.fmi) + "/" +
+               std::to_string(c.occurrences);
+    }
+    ours += "dm1 " + std::to_string(d.us) + " lamps=" + lamps + " dtcs=" + (codes.empty() ? "-" : codes) + "\n";
+  }
+  std::string theirs;
+  std::istringstream lines(py.output);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("dm1 ", 0) == 0) theirs += line + "\n";
+  }
+  EXPECT_EQ(theirs, ours);
+  EXPECT_NE(theirs.find(" dtcs=520194/2/1\n"), std::string::npos) << theirs;
 }
 
 // The last 20 frames (4 s; the tractor has stopped 1 m short of the box) of a replay's obstacles.
