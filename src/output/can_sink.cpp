@@ -171,6 +171,7 @@ SocketCanSink& SocketCanSink::operator=(SocketCanSink&& other) noexcept {
   return *this;
 }
 
+// NOLINTNEXTLINE(readability-make-member-function-const): it changes what the socket receives
 bool SocketCanSink::listen(std::uint8_t own_address) {
   constexpr canid_t kPf = 0x00FF0000U;  // the PDU format byte: the PGN of a PDU1 message without its destination
   const can_filter filters[] = {
