@@ -89,9 +89,7 @@ void Node::answer(std::uint32_t pgn, std::uint8_t requester, bool to_us_alone, d
     case kPgnComponentId:
       send(pgn, std::vector<std::uint8_t>(params_.component_id.begin(), params_.component_id.end()), now_s, out);
       break;
-    case kPgnDm1:
-      send_dm1(now_s, out);
-      break;
+    case kPgnDm1: send_dm1(now_s, out); break;
     case kPgnDm2:
       send(pgn, encode_diagnostic(dm2_), now_s, out);
       ++counters_.dm2_sent;
@@ -159,8 +157,7 @@ void Node::tick(double now_s, std::vector<CanFrame>& out) {
     bam_packets_.pop_front();
     bam_next_s_ = now_s + params_.bam_gap_s;
   }
-  const bool change_due =
-      change_waiting_ && (!change_sent_s_ || now_s - *change_sent_s_ >= params_.dm1_period_s);
+  const bool change_due = change_waiting_ && (!change_sent_s_ || now_s - *change_sent_s_ >= params_.dm1_period_s);
   const bool period_due = dm1_due_s_ && now_s >= *dm1_due_s_;
   if (change_due || period_due) {
     if (change_due) {
