@@ -87,6 +87,10 @@ void Node::answer(std::uint32_t pgn, std::uint8_t requester, bool to_us_alone, d
       break;
     }
     case kPgnComponentId:
+      if (params_.component_id.empty()) {  // none configured: as for a PGN we do not send
+        nack(pgn, requester, to_us_alone, out);
+        return;
+      }
       send(pgn, std::vector<std::uint8_t>(params_.component_id.begin(), params_.component_id.end()), now_s, out);
       break;
     case kPgnDm1: send_dm1(now_s, out); break;
@@ -94,14 +98,15 @@ void Node::answer(std::uint32_t pgn, std::uint8_t requester, bool to_us_alone, d
       send(pgn, encode_diagnostic(dm2_), now_s, out);
       ++counters_.dm2_sent;
       break;
-    default:
-      if (to_us_alone) {
-        out.push_back(acknowledgement(AckControl::Nack, pgn, requester, source()));
-        ++counters_.nacks_sent;
-      }
-      return;
+    default: nack(pgn, requester, to_us_alone, out); return;
   }
   ++counters_.requests_answered;
+}
+
+void Node::nack(std::uint32_t pgn, std::uint8_t requester, bool to_us_alone, std::vector<CanFrame>& out) {
+  if (!to_us_alone) return;  // J1939-21: a global request for what we do not send goes unanswered
+  out.push_back(acknowledgement(AckControl::Nack, pgn, requester, source()));
+  ++counters_.nacks_sent;
 }
 
 void Node::send(std::uint32_t pgn, std::vector<std::uint8_t> data, double now_s, std::vector<CanFrame>& out) {

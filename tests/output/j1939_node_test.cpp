@@ -111,6 +111,13 @@ TEST(J1939Node, NacksAnUnknownRequestToUsAloneOnly) {
   EXPECT_EQ(out[0].id, 0x18E8FF80U);
   EXPECT_EQ(n.counters().nacks_sent, 1U);
   out.clear();
+  NodeParams anonymous = params();
+  anonymous.component_id.clear();
+  std::vector<CanFrame> out2;
+  Node plain = claimed(out2, anonymous);
+  plain.receive(request(kPgnComponentId, 0x26, 0x80), 1.0, out2);
+  ASSERT_EQ(out2.size(), 1U) << "no component id configured: not something we send";
+  EXPECT_EQ(out2[0], acknowledgement(AckControl::Nack, kPgnComponentId, 0x26, 0x80));
   CanFrame bad = request(0xFEE5, 0x26, 0x80);
   bad.len = 2;  // not a request
   n.receive(bad, 1.1, out);

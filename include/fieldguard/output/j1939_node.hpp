@@ -5,7 +5,7 @@
 //
 //   requests (PGN 59904) to global or to our address, answered once the address is ours:
 //     Address Claimed      the claimer's answer (also while claiming, and Cannot Claim without an address);
-//     Software Identification (65242), Component Identification (65259), DM1, DM2: the message;
+//     Software Identification (65242), Component Identification (65259, when configured), DM1, DM2: the message;
 //     any other PGN        a NACK (Acknowledgement 59392) when the request was to us alone; J1939-21 asks for no
 //                          answer to a global request for a PGN we do not send.
 //   DM1 every dm1_period_s (1 s) with the active DTCs, or with none (lamps off) once they clear; a change of the
@@ -83,6 +83,7 @@ class Node {
   void send(std::uint32_t pgn, std::vector<std::uint8_t> data, double now_s, std::vector<CanFrame>& out);
   void send_dm1(double now_s, std::vector<CanFrame>& out);
   void answer(std::uint32_t pgn, std::uint8_t requester, bool to_us_alone, double now_s, std::vector<CanFrame>& out);
+  void nack(std::uint32_t pgn, std::uint8_t requester, bool to_us_alone, std::vector<CanFrame>& out);
   void next_bam(double now_s, std::vector<CanFrame>& out);
   [[nodiscard]] std::uint8_t source() const;
 
