@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "app/recording_sink.hpp"
 #include "daemon/run_stage.hpp"
 #include "fieldguard/output/can_layout.hpp"
 #include "fieldguard/output/j1939.hpp"
@@ -20,23 +21,8 @@ namespace j1939 = output::j1939;
 constexpr std::int64_t kMs = 1'000'000;
 constexpr std::int64_t kT0 = 1'700'000'000'000 * kMs;
 
-struct Sent {
-  output::CanFrame frame;
-  Stamp t;
-};
-
-class RecordingSink final : public output::CanSink {
- public:
-  void write(std::span<const output::CanFrame> frames, Stamp t) override {
-    for (const auto& f : frames) sent.push_back({f, t});
-    stats_.sent += frames.size();
-  }
-  [[nodiscard]] const output::CanSinkStats& stats() const override { return stats_; }
-  std::vector<Sent> sent;
-
- private:
-  output::CanSinkStats stats_;
-};
+using testing::RecordingSink;
+using testing::Sent;
 
 std::uint32_t pgn_of(const output::CanFrame& f) { return output::j1939_fields(f.id).pgn; }
 

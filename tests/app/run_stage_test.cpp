@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "app/recording_sink.hpp"
 #include "fieldguard/output/can_layout.hpp"
 #include "fieldguard/output/safety_params.hpp"
 
@@ -13,23 +14,8 @@ namespace {
 
 constexpr std::int64_t kMs = 1'000'000;
 
-struct Sent {
-  output::CanFrame frame;
-  Stamp t;
-};
-
-class RecordingSink final : public output::CanSink {
- public:
-  void write(std::span<const output::CanFrame> frames, Stamp t) override {
-    for (const auto& f : frames) sent.push_back({f, t});
-    stats_.sent += frames.size();
-  }
-  [[nodiscard]] const output::CanSinkStats& stats() const override { return stats_; }
-  std::vector<Sent> sent;
-
- private:
-  output::CanSinkStats stats_;
-};
+using testing::RecordingSink;
+using testing::Sent;
 
 // The defaults (the 3D LiDAR required, timeout 0.3 s, 3 clear frames, heartbeat 100 ms) without the address claim:
 // these tests are about the stop path from the first tick on (the claim's hold is CanLink's tests').
