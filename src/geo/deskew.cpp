@@ -39,9 +39,10 @@ void count(DeskewStats& s, TrackError e) {
 
 // Sensor point -> target frame at one instant: v = r p + t.
 struct Xf {
-  Eigen::Matrix3d r;
-  Eigen::Vector3d t;
-  bool extrapolated;
+  // Initialised although every use follows a pose (have_xf): g++ 12 at -O3 cannot see that (-Wmaybe-uninitialized).
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  bool extrapolated = false;
 };
 
 // The target frame: plane (identity) or the level frame of t_ref: v_target = l (v_plane - origin).
