@@ -56,11 +56,15 @@ struct BoxLanes {
 // The rings of four points into ring[0, 4).
 inline void copy_rings(const LidarPoint* p, std::uint16_t* ring) {
 #if defined(__SSE2__)
-  // Four word inserts from memory and one eight-byte store, not four loads and four stores.
+  // Four word inserts from memory and one eight-byte store, not four loads and four stores. Without optimisation
+  // (Debug) GCC's _mm_insert_epi16 is a macro that narrows an int to short inside: -Wsign-conversion, not ours.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wsign-conversion"
   __m128i r = _mm_cvtsi32_si128(p[0].ring);
   r = _mm_insert_epi16(r, p[1].ring, 1);
   r = _mm_insert_epi16(r, p[2].ring, 2);
   r = _mm_insert_epi16(r, p[3].ring, 3);
+#pragma GCC diagnostic pop
   std::memcpy(ring, &r, 4 * sizeof(std::uint16_t));
 #else
   for (std::size_t j = 0; j < 4; ++j) ring[j] = p[j].ring;
