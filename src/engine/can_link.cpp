@@ -116,8 +116,10 @@ void CanLink::decided(const output::safety::Decision& d, Stamp t) {
   j1939::BusFaults faults;
   faults.send_errors = send_error_ns_ && t.ns - *send_error_ns_ <= kSendErrorShownNs;
   faults.address_conflict = node_->address_conflict(seconds(t));
-  node_->set_dm1(diagnostics_.update(d, faults), seconds(t), out_);
-  node_->set_dm2(diagnostics_.previously_active());
+  // DM2 changes only with DM1 (a DTC active or no longer): not made again on every decision.
+  if (node_->set_dm1(diagnostics_.update(d, faults), seconds(t), out_)) {
+    node_->set_dm2(diagnostics_.previously_active());
+  }
   flush(t);
 }
 
@@ -133,6 +135,8 @@ void CanLink::bus_recovered(Stamp t) {
   node_->bus_recovered(seconds(t), out_);
   flush(t);
 }
+
+Nanos CanLink::claim_hold() const { return node_ ? nanos_from_seconds(node_params(cfg_).claim.hold_s) : Nanos{0}; }
 
 bool CanLink::no_address() const { return node_ && node_->claimer().state() == j1939::ClaimState::CannotClaim; }
 
@@ -151,8 +155,8 @@ void CanLink::write(std::span<const output::CanFrame> frames, Stamp t) {
   if (cfg_.j1939.controller_name) controller = node_->claimer().address_of(*cfg_.j1939.controller_name);
   pass_.assign(frames.begin(), frames.end());
   for (auto& f : pass_) {
-    f.id = (f.id & ~0xFFU) | source;
-    if (controller && ((f.id >> 16U) & 0xFFU) < 240U) f.id = (f.id & ~0xFF00U) | std::uint32_t{*controller} << 8U;
+    const output::J1939Fields j = output::j1939_fields(f.id);  // j1939_id takes the destination of PDU1 PGNs only
+    f.id = output::j1939_id(j.priority, j.pgn, source, controller.value_or(j.destination));
   }
   bus_.write(pass_, t);
 }

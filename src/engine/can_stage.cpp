@@ -17,7 +17,7 @@ CanStage::CanStage(const Config& cfg, output::CanSink& sink) : cfg_(cfg), link_(
 void CanStage::start(Stamp t) {
   // The claim one hold time before the capture's first data, as a daemon started before its sensors has claimed
   // its address by the time they speak: every decision of the capture reaches the log.
-  link_.start(Stamp{t.ns - nanos_from_seconds(output::j1939::ClaimParams{}.hold_s).count()});
+  link_.start(Stamp{t.ns - link_.claim_hold().count()});
   link_.schedule().tick(t, heartbeat(0));
 }
 

@@ -144,12 +144,12 @@ void Node::send_dm1(double now_s, std::vector<CanFrame>& out) {
   ++counters_.dm1_sent;
 }
 
-void Node::set_dm1(const DiagnosticMessage& dm1, double now_s, std::vector<CanFrame>& out) {
-  const bool changed = dm1.lamps != dm1_.lamps || dm1.dtcs != dm1_.dtcs;
+bool Node::set_dm1(const DiagnosticMessage& dm1, double now_s, std::vector<CanFrame>& out) {
+  if (dm1.lamps == dm1_.lamps && dm1.dtcs == dm1_.dtcs) return false;
   dm1_ = dm1;
-  if (!changed) return;
   change_waiting_ = true;
   tick(now_s, out);
+  return true;
 }
 
 void Node::tick(double now_s, std::vector<CanFrame>& out) {

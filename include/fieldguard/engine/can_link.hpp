@@ -60,9 +60,10 @@ class CanLink final : public output::CanSink {
   void bus_off(Stamp t);
   void bus_recovered(Stamp t);
 
+  // How long the claim holds everything else back (0 without a node).
+  [[nodiscard]] Nanos claim_hold() const;
   // No J1939 address to send from: the safety monitor's "no address".
   [[nodiscard]] bool no_address() const;
-  [[nodiscard]] output::CanEncoder& encoder() { return encoder_; }
   [[nodiscard]] output::CanSchedule& schedule() { return schedule_; }
   [[nodiscard]] const output::j1939::Node* node() const { return node_ ? &*node_ : nullptr; }
   [[nodiscard]] const CanLinkCounts& counts() const { return counts_; }

@@ -60,7 +60,8 @@ class Node {
   // Time passing: the claim's hold, DM1's period, the next BAM packet.
   void tick(double now_s, std::vector<CanFrame>& out);
   // The active DTCs as the daemon sees them now (Diagnostics::update); a change is sent as the rate limit allows.
-  void set_dm1(const DiagnosticMessage& dm1, double now_s, std::vector<CanFrame>& out);
+  // True when they changed.
+  bool set_dm1(const DiagnosticMessage& dm1, double now_s, std::vector<CanFrame>& out);
   // The previously active DTCs, sent on request.
   void set_dm2(const DiagnosticMessage& dm2) { dm2_ = dm2; }
   void bus_off() {
@@ -74,7 +75,6 @@ class Node {
   // Another node used our address within the last 2 s.
   [[nodiscard]] bool address_conflict(double now_s) const;
   [[nodiscard]] const Counters& counters() const { return counters_; }
-  [[nodiscard]] const DiagnosticMessage& dm1() const { return dm1_; }
 
   static constexpr std::uint8_t kDiagnosticPriority = 6;
   static constexpr std::uint8_t kTransportPriority = 7;
