@@ -25,13 +25,13 @@ BusListener::~BusListener() {
 void BusListener::watch() {
   watch_.async_wait(boost::asio::posix::stream_descriptor::wait_read, [this](const boost::system::error_code& ec) {
     if (ec) return;
-    on_bus();
+    socket_.poll();
+    deliver();
     watch();
   });
 }
 
-void BusListener::on_bus() {
-  socket_.poll();
+void BusListener::deliver() {
   const Stamp now = wall_clock_now();
   const bool off = socket_.stats().bus_off;
   if (off != bus_off_) {

@@ -1,9 +1,9 @@
 #pragma once
 // What the J1939 node hears on a SocketCAN bus: the sink's own socket (CAN_RAW does not echo a socket's frames to
-// itself, so an address violation is never our own frame) watched on the io thread. Each time it is readable, and
-// on every tick of the output timer (a write() may have read frames meanwhile), the frames go to the link in
-// order, bus-off and recovery too, and the socket's filters follow the address we hold. Thread contract: the io
-// thread only.
+// itself, so an address violation is never our own frame) watched on the io thread. Each time it is readable the
+// socket is read, and then, as on every tick of the output timer (a write() may have read frames meanwhile), what
+// was read goes to the link in order, bus-off and recovery too, and the socket's filters follow the address we
+// hold. Thread contract: the io thread only.
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/posix/stream_descriptor.hpp>
@@ -27,8 +27,9 @@ class BusListener {
   BusListener(BusListener&&) = delete;
   BusListener& operator=(BusListener&&) = delete;
 
-  // Reads what is waiting and hands it over; the watch calls it, and so does the output timer.
-  void on_bus();
+  // Hands over what the socket has read (the watch's reads and write()'s), bus-off and recovery; no system call
+  // unless our address moved. The watch calls it after reading; the output timer on every tick.
+  void deliver();
   // Empty while the socket took its filters; otherwise why not (a socketpair in tests takes none).
   [[nodiscard]] const std::string& filter_problem() const { return filter_problem_; }
 

@@ -192,7 +192,7 @@ void Daemon::arm_timer() {
   timer_.async_wait([this](const boost::system::error_code& ec) {
     if (ec) return;
     if (listener_) {
-      listener_->on_bus();  // what a write() read meanwhile
+      listener_->deliver();  // what a write() read meanwhile
       if (!listener_->filter_problem().empty() && !filter_problem_logged_) {
         filter_problem_logged_ = true;
         log_->warn("J1939: the CAN socket refused its filters ({}); requests and claims go unheard",
