@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <filesystem>
+#include <optional>
 #include <type_traits>
 
 #include "config/section_readers.hpp"
@@ -10,26 +11,35 @@
 namespace fieldguard::app {
 namespace {
 
+// An unsigned number in decimal (128) or, with 0x, in hex (0x80); nullopt when it is neither or too large for T.
+// `hex` says which it was.
+template <typename T>
+std::optional<T> parse_unsigned(const std::string& s, bool& hex) {
+  hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+  const char* end = s.data() + s.size();
+  T value = 0;
+  const auto [ptr, ec] = std::from_chars(s.data() + (hex ? 2 : 0), end, value, hex ? 16 : 10);
+  if (s.empty() || ec != std::errc() || ptr != end) return std::nullopt;
+  return value;
+}
+
 // A J1939 address, written as a number (128) or in hex as on the tractor's documentation (0x80).
 void read_address(YamlReader& r, const YAML::Node& n, const std::string& path, const char* key, std::uint8_t& out) {
   if (!n.IsMap() || !n[key]) return;
   const YAML::Node v = n[key];
   const std::string p = join_path(path, key);
   const std::string s = v.IsScalar() ? v.Scalar() : std::string();
-  const bool hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
-  const char* begin = s.data() + (hex ? 2 : 0);
-  const char* end = s.data() + s.size();
-  unsigned value = 0;
-  const auto [ptr, ec] = std::from_chars(begin, end, value, hex ? 16 : 10);
-  if (!v.IsScalar() || s.empty() || ec != std::errc() || ptr != end) {
+  bool hex = false;
+  const auto parsed = parse_unsigned<unsigned>(s, hex);
+  if (!v.IsScalar() || !parsed) {
     r.issue(v, p, "expected a J1939 address such as 0x80 or 128, got '" + s + "'");
     return;
   }
-  if (value > 0xFD) {
+  if (*parsed > 0xFD) {
     r.issue(v, p, s + " is not a node address: 0xFE and 0xFF are the J1939 null and global addresses; use 0x00-0xFD");
     return;
   }
-  out = static_cast<std::uint8_t>(value);
+  out = static_cast<std::uint8_t>(*parsed);
 }
 
 // can.j1939: the NAME's fields each in its bits, the controller's NAME as 16 hex digits.
@@ -59,16 +69,13 @@ void read_j1939(YamlReader& r, const YAML::Node& n, J1939Config& c) {
   std::string controller;
   r.text(n, path, "controller_name", controller);
   if (!controller.empty()) {
-    const bool hex = controller.size() > 2 && controller[0] == '0' && (controller[1] == 'x' || controller[1] == 'X');
-    std::uint64_t v = 0;
-    const char* begin = controller.data() + (hex ? 2 : 0);
-    const char* end = controller.data() + controller.size();
-    const auto [ptr, ec] = std::from_chars(begin, end, v, 16);
-    if (!hex || ec != std::errc() || ptr != end) {
+    bool hex = false;
+    const auto v = parse_unsigned<std::uint64_t>(controller, hex);
+    if (!v || !hex) {
       r.issue(n["controller_name"], path + ".controller_name",
               "expected the controller's 64-bit NAME in hex as `inspect` prints it (0x...), got '" + controller + "'");
     } else {
-      c.controller_name = v;
+      c.controller_name = *v;
     }
   }
   r.text(n, path, "component_id", c.component_id);
