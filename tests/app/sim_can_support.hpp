@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "fieldguard/output/can_frame.hpp"
 #include "io/pcap_builder.hpp"
 
 namespace fieldguard::testing {
@@ -83,9 +84,7 @@ inline std::vector<LogFrame> read_candump(const std::string& text) {
 // The J1939 node's own frames (output/j1939_node.hpp: Address Claimed, requests, acknowledgements, transport,
 // DM1/DM2, identifications), which fieldguard.dbc does not describe: its messages are the pipeline's.
 inline bool is_node_frame(std::uint32_t id) {
-  const std::uint32_t pf = (id >> 16U) & 0xFFU;
-  const std::uint32_t pgn = pf < 240U ? (id >> 8U) & 0x3FF00U : (id >> 8U) & 0x3FFFFU;
-  switch (pgn) {
+  switch (output::j1939_fields(id).pgn) {
     case 0xE800:
     case 0xEA00:
     case 0xEB00:
