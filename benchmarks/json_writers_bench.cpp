@@ -183,12 +183,12 @@ Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameRes
                {"points", o.points},
                {"obb",
                 {{"center", vec(o.obb_center.data(), 2)},
-                 {"length", fixed(o.obb_length_m, 3)},
-                 {"width", fixed(o.obb_width_m, 3)},
-                 {"yaw", fixed(o.obb_yaw_rad, 4)}}},
-               {"distance", fixed(o.distance_m, 3)},
-               {"bearing", fixed(o.bearing_deg, 2)},
-               {"height", fixed(o.height_above_ground_m, 3)},
+                 {"length", fixed(static_cast<double>(o.obb_length_m), 3)},
+                 {"width", fixed(static_cast<double>(o.obb_width_m), 3)},
+                 {"yaw", fixed(static_cast<double>(o.obb_yaw_rad), 4)}}},
+               {"distance", fixed(static_cast<double>(o.distance_m), 3)},
+               {"bearing", fixed(static_cast<double>(o.bearing_deg), 2)},
+               {"height", fixed(static_cast<double>(o.height_above_ground_m), 3)},
                {"class", perception::to_string(o.size_class)}};
     if ((o.sources & perception::kSeenBy2d) != 0)
       oj["seen_by"] = (o.sources & perception::kSeenBy3d) != 0 ? "3d+2d" : "2d";
@@ -217,7 +217,7 @@ Json truth_objects(const std::vector<sim::ObjectTruth>& list) {
                  {"max", v3(o.box.max)},
                  {"hits", o.hits},
                  {"raised_hits", o.raised_hits},
-                 {"distance_m", fixed(o.distance_m, 3)}});
+                 {"distance_m", fixed(static_cast<double>(o.distance_m), 3)}});
   }
   return a;
 }
