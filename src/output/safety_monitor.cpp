@@ -204,6 +204,7 @@ Decision Monitor::update(const Input& in) {
   d.clear_frames = clear_;
   d.obstacles_in_zone = obstacles_in_zone_;
   d.unplaceable_obstacles = unplaceable_;
+  if (obstacle_latched_ && nearest_in_zone_) d.nearest_m = (*nearest_in_zone_)[0];
   d.zone = zone_;
   if (!first_ && stop_ == event_stop_ && reason_ == event_reason_ && event_sensors_ == event_sensors_sent_) return d;
 
@@ -222,7 +223,17 @@ Decision Monitor::update(const Input& in) {
       detail = "every reason clear for " + std::to_string(clear_) + (clear_ == 1 ? " frame" : " frames");
       break;
     case Reason::ObstacleInZone: detail = obstacle_text(); break;
-    case Reason::StartingUp: detail = "waiting for " + sensor_list(silent); break;
+    case Reason::StartingUp:
+      // Waiting for a sensor, for plausible data from one, or (every sensor heard and plausible) for the clear
+      // frames that make the first go.
+      if (silent != 0) {
+        detail = "waiting for " + sensor_list(silent);
+      } else if (implausible != 0) {
+        detail = "waiting for plausible data from " + sensor_list(implausible);
+      } else {
+        detail = fmt("every required sensor heard, clear %d of %d frames", clear_, params_.clear_frames);
+      }
+      break;
     case Reason::SensorFault:
       for (std::size_t i = 0; i < kSensorCount; ++i) {
         if ((silent & bit(static_cast<Sensor>(i))) == 0) continue;
@@ -275,6 +286,59 @@ Decision Monitor::update(const Input& in) {
   event_reason_ = reason_;
   event_sensors_sent_ = event_sensors_;
   return d;
+}
+
+std::string headline(const Decision& d, int clear_frames_needed) {
+  if (!d.stop) return "GO";
+  std::string h = "STOP ";
+  switch (d.reason) {
+    case Reason::None: h += "holding"; break;  // not produced by the monitor: a stop always has a reason
+    case Reason::ObstacleInZone:
+      if (d.obstacles_in_zone == 0) {
+        h += fmt("obstacle gone, clear %d of %d frames", d.clear_frames, clear_frames_needed);
+      } else if (d.nearest_m) {
+        h += fmt("obstacle %.1f m ahead", static_cast<double>(std::max(*d.nearest_m, 0.F)));
+      } else {
+        h += "obstacle in the zone (box not finite)";
+      }
+      break;
+    case Reason::SensorFault:
+      h += d.fault_sensors != 0
+               ? sensor_list(d.fault_sensors) + " silent"
+               : fmt("sensor fault cleared, clear %d of %d frames", d.clear_frames, clear_frames_needed);
+      break;
+    case Reason::ImplausibleData:
+      h += d.implausible_sensors != 0
+               ? sensor_list(d.implausible_sensors) + " implausible"
+               : fmt("implausible data cleared, clear %d of %d frames", d.clear_frames, clear_frames_needed);
+      break;
+    case Reason::StartingUp:
+      h += "starting up";
+      if (d.fault_sensors != 0) {
+        h += ": waiting for " + sensor_list(d.fault_sensors);
+      } else if (d.implausible_sensors != 0) {
+        h += ": " + sensor_list(d.implausible_sensors) + " implausible";
+      } else {
+        h += fmt(", clear %d of %d frames", d.clear_frames, clear_frames_needed);
+      }
+      break;
+    case Reason::PipelineLate: h += "pipeline late"; break;
+    case Reason::NoAddress: h += "no CAN address"; break;
+  }
+  return h;
+}
+
+Severity severity(Reason r) {
+  switch (r) {
+    case Reason::None:
+    case Reason::ObstacleInZone:
+    case Reason::StartingUp: return Severity::Info;
+    case Reason::SensorFault:
+    case Reason::ImplausibleData:
+    case Reason::PipelineLate: return Severity::Warning;
+    case Reason::NoAddress: return Severity::Error;
+  }
+  return Severity::Error;
 }
 
 std::string Monitor::obstacle_text() const {

@@ -137,6 +137,60 @@ TEST(SafetyMonitor, StartsStoppedAndWaitsForEveryRequiredSensor) {
   EXPECT_EQ(d.events.size(), 2U);
 }
 
+TEST(SafetyMonitor, FirstDecisionWithEverySensorHeardSaysWhatStartUpWaitsFor) {
+  // Every sensor fresh at the very first frame: started, but go waits for the clear frames. The event says so
+  // (it read "waiting for " with no sensor named).
+  Drive d(lidar_and_ahrs());
+  const Decision r = d.frame();
+  EXPECT_TRUE(d.monitor.started());
+  EXPECT_EQ(r.reason, Reason::StartingUp);
+  ASSERT_TRUE(r.event);
+  EXPECT_EQ(r.event->text, "stop: starting up: every required sensor heard, clear 1 of 3 frames");
+  EXPECT_EQ(headline(r, 3), "STOP starting up, clear 1 of 3 frames");
+}
+
+TEST(SafetyMonitor, HeadlineIsTheDecisionAndItsReasonInAFewWords) {
+  Drive d(lidar_and_ahrs());
+  d.silence(Sensor::Ahrs);
+  EXPECT_EQ(headline(d.tick(0), 3), "STOP starting up: waiting for ahrs");
+  d.resume(Sensor::Ahrs);
+  for (int i = 0; i < 3; ++i) d.frame();
+  EXPECT_EQ(headline(d.frame(), 3), "GO");
+  // An obstacle: how far ahead its near edge is, rounded to a decimetre; then, gone, how far the clearing is.
+  EXPECT_EQ(headline(d.frame({box(5.44F, -0.3F, 6.0F, 0.3F)}), 3), "STOP obstacle 5.4 m ahead");
+  EXPECT_EQ(headline(d.frame({box(7.0F, -0.3F, 8.0F, 0.3F), box(4.96F, 0.5F, 5.5F, 1.0F)}), 3),
+            "STOP obstacle 5.0 m ahead");
+  EXPECT_EQ(headline(d.frame(), 3), "STOP obstacle gone, clear 1 of 3 frames");
+  d.frame();
+  EXPECT_EQ(headline(d.frame(), 3), "GO");
+  // A box reaching behind the sensor: 0.0 m, not a negative distance.
+  EXPECT_EQ(headline(d.frame({box(-1.0F, -0.3F, 1.0F, 0.3F)}), 3), "STOP obstacle 0.0 m ahead");
+  for (int i = 0; i < 3; ++i) d.frame();
+  // Sensor faults and implausible data name the sensor; the clearing after them says so.
+  d.silence(Sensor::Ahrs);
+  EXPECT_EQ(headline(d.tick(500), 3), "STOP ahrs silent");
+  d.resume(Sensor::Ahrs);
+  EXPECT_EQ(headline(d.frame(), 3), "STOP sensor fault cleared, clear 1 of 3 frames");
+  for (int i = 0; i < 2; ++i) d.frame();
+  d.problem(Sensor::Lidar, Problem::TimeWentBack);
+  EXPECT_EQ(headline(d.frame(), 3), "STOP lidar implausible");
+  EXPECT_EQ(headline(d.frame(), 3), "STOP implausible data cleared, clear 1 of 3 frames");
+  for (int i = 0; i < 2; ++i) d.frame();
+  EXPECT_EQ(headline(d.late_frame(420), 3), "STOP pipeline late");
+  d.no_address(true);
+  EXPECT_EQ(headline(d.tick(10), 3), "STOP no CAN address");
+}
+
+TEST(SafetyMonitor, FaultsOfTheMonitorsOwnViewAreWarningsAndNoAddressAnError) {
+  EXPECT_EQ(severity(Reason::None), Severity::Info);
+  EXPECT_EQ(severity(Reason::StartingUp), Severity::Info);
+  EXPECT_EQ(severity(Reason::ObstacleInZone), Severity::Info);
+  EXPECT_EQ(severity(Reason::SensorFault), Severity::Warning);
+  EXPECT_EQ(severity(Reason::ImplausibleData), Severity::Warning);
+  EXPECT_EQ(severity(Reason::PipelineLate), Severity::Warning);
+  EXPECT_EQ(severity(Reason::NoAddress), Severity::Error);
+}
+
 TEST(SafetyMonitor, StartUpSilenceIsNotASensorFault) {
   Drive d(lidar_and_ahrs());
   d.silence(Sensor::Lidar);

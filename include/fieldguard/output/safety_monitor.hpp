@@ -92,9 +92,22 @@ struct Decision {
   int clear_frames = 0;           // consecutive clear frames so far
   int obstacles_in_zone = 0;      // in the newest frame
   int unplaceable_obstacles = 0;  // non-finite boxes in the newest frame (taken to be in the zone)
-  Zone zone;                      // the zone the newest frame was checked against
-  std::optional<Event> event;     // set when stop/go, the reason or its sensors changed
+  std::optional<float>
+      nearest_m;               // the nearest box in the zone, its near edge (x, m ahead of the sensor); newest frame
+  Zone zone;                   // the zone the newest frame was checked against
+  std::optional<Event> event;  // set when stop/go, the reason or its sensors changed
 };
+
+// The decision as an operator reads it first, one short phrase: "GO", "STOP obstacle 5.4 m ahead",
+// "STOP obstacle gone, clear 2 of 5 frames", "STOP gnss silent", "STOP ahrs implausible",
+// "STOP starting up: waiting for gnss, ahrs", "STOP pipeline late", "STOP no CAN address".
+[[nodiscard]] std::string headline(const Decision& d, int clear_frames_needed);
+
+// How much a reason matters to whoever reads the log: Info for what the tractor meets in normal work (starting
+// up, an obstacle, go), Warning for what degrades the monitor's own view (a sensor silent or implausible, the
+// pipeline late), Error for a stop request that reaches nobody (no CAN address).
+enum class Severity : std::uint8_t { Info, Warning, Error };
+[[nodiscard]] Severity severity(Reason r);
 
 class Monitor {
  public:
