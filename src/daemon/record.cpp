@@ -90,7 +90,9 @@ int record(const RecordOptions& opt) {
   if (cfg.scan2d.enabled) {
     scan_log = open_log("scan2d.log", "scan2d scip " + cfg.scan2d.host + ":" + std::to_string(cfg.scan2d.port));
     const io::ScipSourceOptions o = scip_source_options(cfg.scan2d);
-    scip = std::make_unique<io::ScipSource>(io, o, nullptr, [&](const std::string& w) { log->info("scan2d: {}", w); });
+    scip = std::make_unique<io::ScipSource>(io, o, nullptr, [&](bool trouble, const std::string& w) {
+      log->log(trouble ? spdlog::level::warn : spdlog::level::info, "scan2d: {}", w);
+    });
     scip->set_tap([&](ByteSpan b, bool to_sensor, Stamp t) {
       if (scan_log && !scan_log->write(t, to_sensor ? io::Direction::ToSensor : io::Direction::FromSensor, b))
         ++write_failures;
@@ -110,7 +112,9 @@ int record(const RecordOptions& opt) {
           if (gnss_log && !gnss_log->write(t, io::Direction::FromSensor, b)) ++write_failures;
           samples.gnss(b);
         },
-        [&](io::SerialState, const std::string& why) { log->info("gnss: {}", why); }));
+        [&](io::SerialState st, const std::string& why) {
+          log->log(st == io::SerialState::Open ? spdlog::level::info : spdlog::level::warn, "gnss: {}", why);
+        }));
   }
   if (cfg.ahrs.serial.enabled) {
     ahrs_log = open_log("ahrs.log", "ahrs " + cfg.ahrs.serial.device + " " + std::to_string(cfg.ahrs.serial.baud));
@@ -120,7 +124,9 @@ int record(const RecordOptions& opt) {
           if (ahrs_log && !ahrs_log->write(t, io::Direction::FromSensor, b)) ++write_failures;
           samples.ahrs(b);
         },
-        [&](io::SerialState, const std::string& why) { log->info("ahrs: {}", why); }));
+        [&](io::SerialState st, const std::string& why) {
+          log->log(st == io::SerialState::Open ? spdlog::level::info : spdlog::level::warn, "ahrs: {}", why);
+        }));
   }
   for (auto& s : serial) s->start();
 

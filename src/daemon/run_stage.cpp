@@ -42,7 +42,7 @@ void LiveStage::sensor_problem(safety::Sensor s, safety::Problem p) {
 void LiveStage::note(const safety::Decision& d, const char* what) {
   if (!d.event) return;
   ++counts_.changes;
-  logger("safety")->info("{}: {}", what, d.event->text);
+  log_safety_event(*d.event, what);
 }
 
 const safety::Decision& LiveStage::frame(const LidarFrame& f, const perception::FrameResult& result, Stamp data_end,

@@ -92,7 +92,7 @@ void CanStage::frame(const LidarFrame& f, const perception::FrameResult& result,
   }
   if (d.event) {
     ++counts_.changes;
-    logger("safety")->info("rotation {}: {}", f.index, d.event->text);
+    log_safety_event(*d.event, "rotation " + std::to_string(f.index));
   }
   output::FrameReport report;
   report.frame_counter = static_cast<std::uint32_t>(f.index);

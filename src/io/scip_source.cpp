@@ -17,7 +17,7 @@ struct ScipSource::Impl {
         link(io, options.tcp,
              {.on_connected = [this] { connected(); },
               .on_data = [this](ByteSpan b, Stamp t) { data(b, t); },
-              .on_state = [this](TcpState, const std::string& why) { say(why); }}) {}
+              .on_state = [this](TcpState state, const std::string& why) { say(state == TcpState::Backoff, why); }}) {}
 
   ScipSourceOptions options;
   ScanHandler on_scan;
@@ -27,8 +27,8 @@ struct ScipSource::Impl {
   scip::Session session;
   TcpClient link;  // last: its handlers use the members above
 
-  void say(const std::string& s) const {
-    if (on_state) on_state(s);
+  void say(bool trouble, const std::string& s) const {
+    if (on_state) on_state(trouble, s);
   }
 
   void send(const std::string& bytes) {
@@ -48,7 +48,7 @@ struct ScipSource::Impl {
     stats.decode_errors += ev.decode_errors;
     for (const auto& st : ev.sensor_status) {
       ++stats.sensor_trouble;
-      say("2D LiDAR reports status " + st);
+      say(true, "2D LiDAR reports status " + st);
     }
     for (const auto& s : ev.scans) {
       ++stats.scans;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/child_process.hpp"
@@ -57,7 +58,7 @@ ScipSourceOptions options(std::uint16_t port) {
 
 struct Collected {
   std::vector<scip::Scan> scans;
-  std::vector<std::string> states;
+  std::vector<std::pair<bool, std::string>> states;  // trouble, what
 };
 
 TEST(ScipSource, StartsUpAndStreamsTheObstacleInFront) {
@@ -95,15 +96,28 @@ TEST(ScipSource, ConnectionDroppedMidScanIsMadeAgain) {
   Collected c;
   ScipSource src(
       io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); },
-      [&](const std::string& w) { c.states.push_back(w); });
+      [&](bool trouble, const std::string& w) {
+        c.states.push_back({trouble, w});
+      });
   src.start();
   ASSERT_TRUE(run_until(
       io, [&] { return src.link().connects.load() >= 2 && c.scans.size() >= 7; }, 8000ms));
   EXPECT_GE(src.link().disconnects.load(), 1U);
   for (const auto& s : c.scans) EXPECT_EQ(s.ranges_mm.size(), 1081U);  // the half scan never came out
-  bool said_closed = false;
-  for (const auto& w : c.states) said_closed = said_closed || w.find("closed the connection") != std::string::npos;
+  // The loss is trouble (a warning in the daemon's log), connecting again is not.
+  bool said_closed = false, said_connected = false;
+  for (const auto& [trouble, w] : c.states) {
+    if (w.find("closed the connection") != std::string::npos) {
+      said_closed = true;
+      EXPECT_TRUE(trouble) << w;
+    }
+    if (w.find("connected") == 0) {
+      said_connected = true;
+      EXPECT_FALSE(trouble) << w;
+    }
+  }
   EXPECT_TRUE(said_closed);
+  EXPECT_TRUE(said_connected);
   src.stop();
 }
 
@@ -129,13 +143,16 @@ TEST(ScipSource, LaserThatWillNotLightIsReportedAndRetried) {
   Collected c;
   ScipSource src(
       io, options(emu.port()), [&](const scip::Scan& s, const scip::Geometry&, Stamp) { c.scans.push_back(s); },
-      [&](const std::string& w) { c.states.push_back(w); });
+      [&](bool trouble, const std::string& w) {
+        c.states.push_back({trouble, w});
+      });
   src.start();
   ASSERT_TRUE(run_until(
       io, [&] { return src.stats().refusals.load() >= 2; }, 5000ms));
   EXPECT_TRUE(c.scans.empty());
   bool said = false;
-  for (const auto& w : c.states) said = said || w.find("refused BM with status 01") != std::string::npos;
+  for (const auto& [trouble, w] : c.states)
+    said = said || (trouble && w.find("refused BM with status 01") != std::string::npos);
   EXPECT_TRUE(said);
   src.stop();
 }

@@ -34,8 +34,9 @@ struct ScipSourceStats {
 class ScipSource {
  public:
   using ScanHandler = std::function<void(const scip::Scan&, const scip::Geometry&, Stamp rx_time)>;
-  // Every change of the link or of the protocol, with a one-line reason.
-  using StateHandler = std::function<void(const std::string& what)>;
+  // Every change of the link or of the protocol, with a one-line reason. `trouble`: the link was lost or refused
+  // (the source waits and connects again) or the sensor reported a fault; false for connecting and connected.
+  using StateHandler = std::function<void(bool trouble, const std::string& what)>;
 
   ScipSource(boost::asio::io_context& io, ScipSourceOptions options, ScanHandler on_scan, StateHandler on_state = {});
   ~ScipSource();
