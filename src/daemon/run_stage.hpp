@@ -54,6 +54,10 @@ class LiveStage {
   [[nodiscard]] const LiveStageCounts& counts() const { return counts_; }
   [[nodiscard]] const CanLink& link() const { return link_; }
   [[nodiscard]] const std::optional<output::safety::Decision>& last_decision() const { return last_; }
+  // The host time of the sensor's newest data, as the monitor sees it (the 3D LiDAR: its newest datagram); 0 = never.
+  [[nodiscard]] Stamp last_data(output::safety::Sensor s) const {
+    return input_.sensors[static_cast<std::size_t>(s)].last_data;
+  }
 
  private:
   [[nodiscard]] output::Heartbeat heartbeat(std::uint64_t frames_lost) const;

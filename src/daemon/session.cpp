@@ -33,6 +33,17 @@ sync::SensorKind kind_of(safety::Sensor s) {
   return sync::SensorKind::Lidar3d;
 }
 
+// Whether the configuration switches the sensor's source on (the 3D LiDAR always is).
+bool enabled(const Config& cfg, safety::Sensor s) {
+  switch (s) {
+    case safety::Sensor::Lidar: return true;
+    case safety::Sensor::Scan2d: return cfg.scan2d.enabled;
+    case safety::Sensor::Gnss: return cfg.gnss.serial.enabled;
+    case safety::Sensor::Ahrs: return cfg.ahrs.serial.enabled;
+  }
+  return true;
+}
+
 }  // namespace
 
 Session::Session(boost::asio::io_context& io, Config cfg, CanLink& link, SystemdNotifier& notify, bool& ready)
@@ -73,7 +84,9 @@ void Session::start() {
           fusion_.scan(scan, t, jobs_);
           submit_jobs();
         },
-        [this](const std::string& w) { log_->info("scan2d: {}", w); });
+        [this](bool trouble, const std::string& w) {
+          log_->log(trouble ? spdlog::level::warn : spdlog::level::info, "scan2d: {}", w);
+        });
     scip_->start();
   }
   // GNSS and AHRS count as heard when their bytes arrive; the bytes go to the frame maker.
@@ -90,7 +103,10 @@ void Session::start() {
           }
           submit_jobs();
         },
-        [this, name](io::SerialState, const std::string& why) { log_->info("{}: {}", name, why); }));
+        [this, name](io::SerialState st, const std::string& why) {
+          // Open is good news; closed (lost, cannot open) and silent are what an operator must see.
+          log_->log(st == io::SerialState::Open ? spdlog::level::info : spdlog::level::warn, "{}: {}", name, why);
+        }));
     serial_.back()->start();
   };
   serial(cfg_.gnss.serial, safety::Sensor::Gnss, "gnss");
@@ -199,24 +215,44 @@ void Session::on_tick(std::chrono::nanoseconds late) {
 }
 
 std::string Session::status(Stamp now) const {
-  std::optional<sync::SensorKind> waiting;
-  for (std::size_t i = 0; i < safety::kSensorCount && !waiting; ++i) {
+  // The decision first, as the operator reads it ("STOP obstacle 5.4 m ahead", "GO"); then what is wrong; then
+  // the detail. Before the first decision the tractor is stopped: starting up.
+  const auto& d = stage_.last_decision();
+  std::string line = d ? safety::headline(*d, cfg_.safety.clear_frames) : std::string("STOP starting up");
+  std::string faults;
+  const auto fault = [&faults](const std::string& f) { faults += (faults.empty() ? "" : ", ") + f; };
+  std::uint8_t off = 0;
+  char buf[128];
+  for (std::size_t i = 0; i < safety::kSensorCount; ++i) {
     const auto s = static_cast<safety::Sensor>(i);
+    const auto k = kind_of(s);
+    if (!enabled(cfg_, s)) {
+      off = static_cast<std::uint8_t>(off | (1U << static_cast<unsigned>(k)));
+      continue;
+    }
+    // Silence as the safety monitor judges it (every datagram of the 3D LiDAR counts, not only whole rotations).
     const auto& p = cfg_.safety.sensor(s);
-    const auto age = health_.age_s(kind_of(s), now);
-    if (p.required && (!age || *age > p.timeout_s)) waiting = kind_of(s);
+    const Stamp last = stage_.last_data(s);
+    const auto age = last.ns == 0 ? std::nullopt : std::optional<double>(static_cast<double>(now.ns - last.ns) * 1e-9);
+    if (age && *age <= p.timeout_s) continue;
+    if (age) {
+      std::snprintf(buf, sizeof buf, "%s silent %.1f s", std::string(safety::to_string(s)).c_str(), *age);
+    } else {
+      std::snprintf(buf, sizeof buf, "%s never heard", std::string(safety::to_string(s)).c_str());
+    }
+    fault(std::string(buf) + (p.required ? "" : " (not required)"));
   }
-  std::string line =
-      health_.status_line(now, waiting, stage_.counts().frames, fusion_.stream().counters().partial_rotations);
-  if (const auto& d = stage_.last_decision()) {
-    line += d->stop ? " | STOP " + std::string(safety::to_string(d->reason)) : " | GO";
-  }
+  if (stalled_) fault("pipeline stalled");
   if (const sync::Synchronizer* sy = fusion_.synchronizer()) {
-    if (auto w = sy->waiting_for(now)) line += " | sync waiting for " + std::string(sync::to_string(*w));
+    if (auto w = sy->waiting_for(now)) fault("sync waiting for " + std::string(sync::to_string(*w)));
   }
-  if (stalled_) line += " | pipeline stalled";
+  if (!faults.empty()) line += " | " + faults;
+  line += " | " + health_.sensors_line(now, off);
+  std::snprintf(buf, sizeof buf, " | frames %llu, incomplete %llu",
+                static_cast<unsigned long long>(stage_.counts().frames),
+                static_cast<unsigned long long>(fusion_.stream().counters().partial_rotations));
+  line += buf;
   if (latency_.count() > 0) {
-    char buf[128];
     std::snprintf(buf, sizeof buf, " | latency p99 %.2f ms (max %.2f), io gap max %.2f ms, %llu late",
                   static_cast<double>(latency_.quantile_ns(0.99)) * 1e-6, static_cast<double>(latency_.max_ns()) * 1e-6,
                   static_cast<double>(io_gap_.max_ns()) * 1e-6, static_cast<unsigned long long>(late_));
@@ -227,7 +263,6 @@ std::string Session::status(Stamp now) const {
     std::vector<float> v(timed_.size());
     for (std::size_t i = 0; i < v.size(); ++i) v[i] = timed_[i].total_us;
     const float worst = *std::max_element(v.begin(), v.end());
-    char buf[96];
     std::snprintf(buf, sizeof buf, " | detection %.1f ms (max %.1f) over %zu rotations",
                   static_cast<double>(median_of(v)) * 1e-3, static_cast<double>(worst) * 1e-3, v.size());
     line += buf;

@@ -41,6 +41,30 @@ double HealthMonitor::rate_hz(SensorKind k, Stamp now) const {
   return static_cast<double>(n) / (static_cast<double>(window_ns_) * 1e-9);
 }
 
+std::string HealthMonitor::sensors_line(Stamp now, std::uint8_t off) const {
+  std::string s;
+  char buf[48];
+  for (SensorKind k : kAllSensors) {
+    if (k != SensorKind::Lidar3d) s += ", ";
+    s += to_string(k);
+    if ((off & (1U << index(k))) != 0) {
+      s += " off";
+      continue;
+    }
+    if (!sensors_[index(k)].last_host) {
+      s += " never heard";
+    } else {
+      std::snprintf(buf, sizeof buf, " %.1f Hz", rate_hz(k, now));
+      s += buf;
+    }
+    if (const std::uint64_t e = sensors_[index(k)].errors.total(); e > 0) {
+      std::snprintf(buf, sizeof buf, " err %llu", static_cast<unsigned long long>(e));
+      s += buf;
+    }
+  }
+  return s;
+}
+
 std::string HealthMonitor::status_line(Stamp now, std::optional<SensorKind> waiting, std::uint64_t frames,
                                        std::uint64_t incomplete) const {
   std::string s;
@@ -57,21 +81,8 @@ std::string HealthMonitor::status_line(Stamp now, std::optional<SensorKind> wait
   } else {
     s += "ok";
   }
-  s += " |";
-  for (SensorKind k : kAllSensors) {
-    s += k == SensorKind::Lidar3d ? " " : ", ";
-    s += to_string(k);
-    if (!sensors_[index(k)].last_host) {
-      s += " never";
-    } else {
-      std::snprintf(buf, sizeof buf, " %.1f Hz", rate_hz(k, now));
-      s += buf;
-    }
-    if (const std::uint64_t e = sensors_[index(k)].errors.total(); e > 0) {
-      std::snprintf(buf, sizeof buf, " err %llu", static_cast<unsigned long long>(e));
-      s += buf;
-    }
-  }
+  s += " | ";
+  s += sensors_line(now, 0);
   std::snprintf(buf, sizeof buf, " | frames %llu, incomplete %llu", static_cast<unsigned long long>(frames),
                 static_cast<unsigned long long>(incomplete));
   s += buf;

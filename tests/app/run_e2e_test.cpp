@@ -10,6 +10,7 @@
 #include <signal.h>
 #include <sys/ptrace.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -310,7 +311,14 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   } else {
     config = write_config(port, log);
   }
-  Process daemon(daemon_argv(config), dir.path() / "daemon.out");
+  // Its stderr as systemd's journal stream: JOURNAL_STREAM names the file (device and inode; Process truncates
+  // it, the inode stays), so each line starts with its syslog priority, as journald reads them.
+  const fs::path daemon_out = dir.path() / "daemon.out";
+  std::ofstream(daemon_out).close();
+  struct stat st {};
+  ASSERT_EQ(::stat(daemon_out.c_str(), &st), 0);
+  Process daemon(daemon_argv(config), daemon_out,
+                 {{"JOURNAL_STREAM", std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino)}});
   ASSERT_TRUE(daemon.wait_for("listening for the 3D LiDAR on udp port " + std::to_string(port), 60s))
       << daemon.output();
   // The J1939 address is ours 250 ms after the claim: from then on every decision reaches the bus.
@@ -335,6 +343,18 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   ASSERT_GT(silent_us, 0) << player_out;
   // The LiDAR is silent now: the daemon must say so (timeout 0.3 s) while it keeps running.
   ASSERT_TRUE(daemon.wait_for("lidar silent", 30s)) << daemon.output();
+  // Priorities as journald reads them: the silent sensor a warning (`journalctl -p warning` shows it), the
+  // obstacle stop and the go information; every line carries one.
+  EXPECT_NE(daemon.output().find("<4>[safety] warning: "), std::string::npos) << daemon.output();
+  EXPECT_NE(daemon.output().find("<6>[safety] info: "), std::string::npos) << daemon.output();
+  std::istringstream lines(daemon.output());
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("[safety]") == std::string::npos) continue;
+    const bool degraded = line.find(": stop: sensor fault") != std::string::npos ||
+                          line.find(": stop: implausible data") != std::string::npos ||
+                          line.find(": stop: pipeline late") != std::string::npos;
+    EXPECT_EQ(line.rfind(degraded ? "<4>[safety] warning: " : "<6>[safety] info: ", 0), 0U) << line;
+  }
   std::this_thread::sleep_for(300ms);
   ASSERT_EQ(::kill(daemon.pid(), SIGTERM), 0);
   const auto t_term = WallClock::now();
@@ -643,6 +663,15 @@ TEST_F(RunE2e, NotifyReadyThenWatchdogWhileHealthyAndNoneWhileAWorkerHangs) {
   // READY first (it waited in the socket), then pings at most every quarter of WatchdogSec.
   ASSERT_FALSE(msgs.empty());
   EXPECT_EQ(msgs.front().rfind("READY=1\nSTATUS=", 0), 0U) << msgs.front();
+  // Every status begins with the decision (the operator's first question), and names the sensors switched off
+  // in this configuration as off.
+  for (const auto& m : msgs) {
+    const auto at = m.find("STATUS=");
+    if (at == std::string::npos) continue;
+    const std::string status = m.substr(at + 7);
+    EXPECT_TRUE(status.rfind("STOP ", 0) == 0 || status.rfind("GO", 0) == 0) << status;
+    EXPECT_NE(status.find("scan2d off, gnss off, ahrs off"), std::string::npos) << status;
+  }
   EXPECT_EQ(count_with(msgs, "READY=1"), 1);
   EXPECT_GE(count_with(msgs, "WATCHDOG=1"), 3) << daemon.output();
   EXPECT_LE(count_with(msgs, "WATCHDOG=1"), 8);

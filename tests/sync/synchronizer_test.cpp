@@ -219,7 +219,7 @@ TEST(Synchronizer, SamplesWithoutTimeAreCounted) {
   EXPECT_EQ(sync.health().get(SensorKind::Scan2d).errors.decode, 3U);
   EXPECT_EQ(sync.assembler().pending(), 0U);
   const std::string s = sync.status(Stamp{kT0});
-  EXPECT_NE(s.find("scan2d never err 3"), std::string::npos) << s;
+  EXPECT_NE(s.find("scan2d never heard err 3"), std::string::npos) << s;
   EXPECT_NE(s.find("ahrs 0.5 Hz err 1"), std::string::npos) << s;
 }
 

@@ -44,9 +44,12 @@ class HealthMonitor {
   [[nodiscard]] double rate_hz(SensorKind k, Stamp now) const;
 
   // "waiting for gnss (silent 1.4 s) | lidar3d 10.0 Hz, scan2d 40.0 Hz, gnss 0.0 Hz err 3, ahrs 100.0 Hz |
-  //  frames 120, incomplete 1". `waiting` empty: "ok | ...". A sensor never heard of reads "never".
+  //  frames 120, incomplete 1". `waiting` empty: "ok | ...". A sensor never heard of reads "never heard".
   [[nodiscard]] std::string status_line(Stamp now, std::optional<SensorKind> waiting, std::uint64_t frames,
                                         std::uint64_t incomplete) const;
+  // Each sensor's rate and errors: "lidar3d 10.0 Hz, scan2d off, gnss never heard, ahrs 100.0 Hz err 3". The
+  // sensors in `off` (bit(SensorKind) of those switched off in the configuration) read "off".
+  [[nodiscard]] std::string sensors_line(Stamp now, std::uint8_t off) const;
 
  private:
   static std::size_t index(SensorKind k) { return static_cast<std::size_t>(k); }
