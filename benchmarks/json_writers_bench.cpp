@@ -27,6 +27,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <optional>
 #include <random>
 #include <string>
@@ -143,7 +144,8 @@ Json vec(const float* v, int n) {
 
 Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameResult& result,
                              const app::FusionInfo* fusion, const Mounting* lidar) {
-  Json j = {{"frame", frame.index},
+  Json j = {{"version", app::kObstaclesJsonVersion},
+            {"frame", frame.index},
             {"stamp", fixed(frame.host_stamp.seconds(), 6)},
             {"partial", frame.partial},
             {"points_in", frame.points.size()}};
@@ -185,7 +187,7 @@ Json obstacles_json_nlohmann(const LidarFrame& frame, const perception::FrameRes
                 {{"center", vec(o.obb_center.data(), 2)},
                  {"length", fixed(static_cast<double>(o.obb_length_m), 3)},
                  {"width", fixed(static_cast<double>(o.obb_width_m), 3)},
-                 {"yaw", fixed(static_cast<double>(o.obb_yaw_rad), 4)}}},
+                 {"yaw_deg", fixed(static_cast<double>(o.obb_yaw_rad) * (180.0 / std::numbers::pi), 2)}}},
                {"distance", fixed(static_cast<double>(o.distance_m), 3)},
                {"bearing", fixed(static_cast<double>(o.bearing_deg), 2)},
                {"height", fixed(static_cast<double>(o.height_above_ground_m), 3)},

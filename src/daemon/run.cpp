@@ -33,15 +33,7 @@ namespace {
 
 constexpr auto kTick = std::chrono::milliseconds(5);
 
-// can.sink: none. Frames are counted and go nowhere.
-class NullSink final : public output::CanSink {
- public:
-  void write(std::span<const output::CanFrame> frames, Stamp /*t*/) override { stats_.sent += frames.size(); }
-  [[nodiscard]] const output::CanSinkStats& stats() const override { return stats_; }
-
- private:
-  output::CanSinkStats stats_;
-};
+using output::NullSink;  // can.sink: none
 
 // What the sink was made from: a reload keeps the open sink (and its log file) when this is unchanged.
 struct SinkKey {

@@ -208,6 +208,10 @@ class Replay {
   std::string bev_dir_;
   std::ofstream obstacles_out_;
   std::optional<output::CandumpLogSink> can_log_;
+  // Without --can-log the obstacles JSONL still carries each frame's decision: the stage decides into a sink that
+  // sends nowhere, from a configuration without the J1939 address claim (nothing is on a bus to contest it).
+  output::NullSink no_bus_;
+  std::optional<Config> decide_cfg_;
   std::optional<CanStage> can_;
   bool detect_ = false;  // the detection pipeline runs (an output needs its result)
   // The frame path.
@@ -310,6 +314,10 @@ bool Replay::open_outputs() {
       std::fprintf(stderr, "fieldguard replay: --can-log: %s\n", e.what());
       return false;
     }
+  } else if (obstacles_out_.is_open()) {
+    decide_cfg_ = cfg_;
+    decide_cfg_->can.j1939.address_claim = false;
+    can_.emplace(*decide_cfg_, no_bus_);
   }
   return true;
 }
@@ -375,14 +383,17 @@ void Replay::write_frame(const Pool::Result& r) {
   }
   obstacles_total_ += result.obstacles.size();
   times_.push_back(result.times);
+  // Decided before the obstacles line is written: the line carries the decision.
+  if (can_) decide(r, f, result);
   if (obstacles_out_.is_open() && write_error_.empty()) {
-    obstacles_out_ << obstacles_json_line(f, result, fused, &cfg_.lidar.mounting) << '\n';
+    const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
+    obstacles_out_ << obstacles_json_line(f, result, fused, &cfg_.lidar.mounting, decision, cfg_.safety.clear_frames)
+                   << '\n';
     if (!obstacles_out_) write_error_ = "cannot write " + *opt_.obstacles_out;
   }
   if (r.output->bev && write_error_.empty()) {
     write_error_ = write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string(), *r.output->bev);
   }
-  if (can_) decide(r, f, result);
 }
 
 // The safety monitor on one frame, with every sensor as it was heard at the frame's decision time.
@@ -398,7 +409,7 @@ void Replay::decide(const Pool::Result& r, const LidarFrame& f, perception::Fram
     problems_.pop_front();
   }
   can_->frame(f, result, r.input->complete, lost_);
-  if (can_log_->stats().write_errors != 0 && write_error_.empty()) write_error_ = can_log_error();
+  if (can_log_ && can_log_->stats().write_errors != 0 && write_error_.empty()) write_error_ = can_log_error();
 }
 
 void Replay::submit_jobs() {
@@ -493,7 +504,7 @@ void Replay::read() {
   }
   if (can_) {
     can_->tick(last_time_, lost_);
-    if (can_log_->stats().write_errors != 0 && write_error_.empty()) write_error_ = can_log_error();
+    if (can_log_ && can_log_->stats().write_errors != 0 && write_error_.empty()) write_error_ = can_log_error();
   }
   if (progress_) std::fprintf(stderr, "\r%60s\r", "");
 }
@@ -553,8 +564,10 @@ int Replay::finish() {
     std::printf("  stop decisions    %llu stop, %llu go, %llu changes\n",
                 static_cast<unsigned long long>(cc.stop_frames), static_cast<unsigned long long>(cc.go_frames),
                 static_cast<unsigned long long>(cc.changes));
-    std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log_->stats().sent));
-    std::printf("  j1939             %s\n", j1939_summary(can_->link()).c_str());
+    if (can_log_) {
+      std::printf("  can frames        %llu\n", static_cast<unsigned long long>(can_log_->stats().sent));
+      std::printf("  j1939             %s\n", j1939_summary(can_->link()).c_str());
+    }
   }
   print_fusion_summary();
   if (samples_) samples_->finish();

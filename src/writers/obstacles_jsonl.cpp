@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <optional>
 
 namespace fieldguard::app {
@@ -30,19 +31,25 @@ void field(std::string& s, const char* key, double v, int decimals) {
   num(s, v, decimals);
 }
 
+// The names of the values of `all` whose bit is set in `mask`, as JSON strings separated by commas, in `all`'s order.
+template <class Values, class Bit>
+void names_in(std::string& s, const Values& all, std::uint8_t mask, Bit bit_of) {
+  bool first = true;
+  for (const auto v : all) {
+    if ((mask & bit_of(v)) == 0) continue;
+    s += first ? "\"" : ",\"";
+    s += to_string(v);
+    s += '"';
+    first = false;
+  }
+}
+
 void fusion_json(std::string& s, const FusionInfo& f) {
   s += ",\"fusion\":{\"levelling\":\"";
   s += levelling_name(f.levelling);
   s += "\",\"rotations\":" + std::to_string(f.rotations) + ",\"scan_points\":" + std::to_string(f.scan_points) +
        ",\"missing\":[";
-  bool first = true;
-  for (const sync::SensorKind k : sync::kAllSensors) {
-    if ((f.missing & sync::bit(k)) == 0) continue;
-    s += first ? "\"" : ",\"";
-    s += sync::to_string(k);
-    s += '"';
-    first = false;
-  }
+  names_in(s, sync::kAllSensors, f.missing, [](sync::SensorKind k) { return sync::bit(k); });
   s += "],\"timed_out\":";
   s += f.timed_out ? "true" : "false";
   s += ",\"dropped_points\":" + std::to_string(f.stats.lidar.dropped() + f.stats.scan.dropped());
@@ -66,6 +73,20 @@ void fusion_json(std::string& s, const FusionInfo& f) {
     s += '}';
   }
   s += '}';
+}
+
+// Our texts have no character JSON must escape (the headline is built from fixed words, sensor names and numbers).
+void decision_json(std::string& s, const output::safety::Decision& d, int clear_frames) {
+  namespace safety = output::safety;
+  s += ",\"decision\":{\"stop\":";
+  s += d.stop ? "true" : "false";
+  s += ",\"reason\":\"";
+  s += safety::to_string(d.reason);
+  s += "\",\"reasons\":[";
+  names_in(s, safety::kReasonPriority, d.reasons, [](safety::Reason r) { return safety::bit(r); });
+  s += "],\"headline\":\"";
+  s += safety::headline(d, clear_frames);
+  s += "\"}";
 }
 
 // The detection frame's pose on the plane (detection_pose): p_plane = origin + Rz(yaw) p_detect.
@@ -95,12 +116,15 @@ const char* levelling_name(geo::Levelling l) {
 }
 
 std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result,
-                                const FusionInfo* fusion, const Mounting* lidar) {
-  std::string s = "{\"frame\":" + std::to_string(frame.index) + ",\"stamp\":";
+                                const FusionInfo* fusion, const Mounting* lidar,
+                                const output::safety::Decision* decision, int clear_frames) {
+  std::string s = "{\"version\":" + std::to_string(kObstaclesJsonVersion) +
+                  ",\"frame\":" + std::to_string(frame.index) + ",\"stamp\":";
   num(s, frame.host_stamp.seconds(), 6);
   s += ",\"partial\":";
   s += frame.partial ? "true" : "false";
   s += ",\"points_in\":" + std::to_string(frame.points.size());
+  if (decision != nullptr) decision_json(s, *decision, clear_frames);
   if (fusion != nullptr) fusion_json(s, *fusion);
   const std::optional<perception::FramePose> pose =
       fusion != nullptr && lidar != nullptr ? detection_pose(*fusion, *lidar) : std::nullopt;
@@ -117,7 +141,7 @@ std::string obstacles_json_line(const LidarFrame& frame, const perception::Frame
     vec(s, o.obb_center.data(), 2);
     field(s, ",\"length\":", static_cast<double>(o.obb_length_m), 3);
     field(s, ",\"width\":", static_cast<double>(o.obb_width_m), 3);
-    field(s, ",\"yaw\":", static_cast<double>(o.obb_yaw_rad), 4);
+    field(s, ",\"yaw_deg\":", static_cast<double>(o.obb_yaw_rad) * (180.0 / std::numbers::pi), 2);
     field(s, "},\"distance\":", static_cast<double>(o.distance_m), 3);
     field(s, ",\"bearing\":", static_cast<double>(o.bearing_deg), 2);
     field(s, ",\"height\":", static_cast<double>(o.height_above_ground_m), 3);

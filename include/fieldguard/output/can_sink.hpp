@@ -56,6 +56,16 @@ class CanSink {
   CanSink& operator=(CanSink&&) = default;
 };
 
+// Frames counted and sent nowhere: the daemon's `can.sink: none`, and replay deciding without `--can-log`.
+class NullSink final : public CanSink {
+ public:
+  void write(std::span<const CanFrame> frames, Stamp /*t*/) override { stats_.sent += frames.size(); }
+  [[nodiscard]] const CanSinkStats& stats() const override { return stats_; }
+
+ private:
+  CanSinkStats stats_;
+};
+
 class CandumpLogSink final : public CanSink {
  public:
   // Creates or truncates `path`; throws std::runtime_error naming the file and the reason if it cannot,

@@ -8,12 +8,19 @@
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/core/mounting.hpp"
 #include "fieldguard/engine/fusion.hpp"
+#include "fieldguard/output/safety_monitor.hpp"
 #include "fieldguard/perception/obstacle.hpp"
 
 namespace fieldguard::app {
 
-// {"frame":i,"stamp":s,"partial":b,"points_in":n,"obstacles":[{"min":[x,y,z],"max":[x,y,z],"points":n,
-//  "obb":{"center":[x,y],"length":l,"width":w,"yaw":rad},"distance":m,"bearing":deg,"height":m,"class":"small"}]}
+// {"version":2,"frame":i,"stamp":s,"partial":b,"points_in":n,
+//  "decision":{"stop":b,"reason":"obstacle in zone","reasons":["obstacle in zone",...],"headline":"STOP obstacle
+//  5.4 m ahead"},
+//  "obstacles":[{"min":[x,y,z],"max":[x,y,z],"points":n,"obb":{"center":[x,y],"length":l,"width":w,"yaw_deg":deg},
+//  "distance":m,"bearing":deg,"height":m,"class":"small"}]}
+// Lengths in metres, angles in degrees (version 1 gave the box's yaw in radians as "yaw"). Its JSON Schema:
+// docs/obstacles.schema.json. "decision" when the safety monitor decided the frame (replay always does), with
+// "reason" "none" when it is go and "reasons" every active reason (safety_monitor.hpp).
 // A fused frame (fusion.hpp) adds, after "points_in":
 //  "fusion":{"levelling":"full"|"attitude_only"|"none","rotations":n,"scan_points":n,"missing":["gnss",...],
 //            "timed_out":b,"dropped_points":n,"pose":{"easting":m,"northing":m,"up":m,"zone":z,"roll":deg,
@@ -25,7 +32,12 @@ namespace fieldguard::app {
 // "full", "attitude_only" or "none", as the "fusion" object's "levelling" says it.
 [[nodiscard]] const char* levelling_name(geo::Levelling l);
 
+// The lines' format version ("version"), raised on any change a reader must know of.
+inline constexpr int kObstaclesJsonVersion = 2;
+
+// `decision` and `clear_frames` (safety.clear_frames, for the headline): the frame's decision, when there is one.
 [[nodiscard]] std::string obstacles_json_line(const LidarFrame& frame, const perception::FrameResult& result,
-                                              const FusionInfo* fusion = nullptr, const Mounting* lidar = nullptr);
+                                              const FusionInfo* fusion = nullptr, const Mounting* lidar = nullptr,
+                                              const output::safety::Decision* decision = nullptr, int clear_frames = 3);
 
 }  // namespace fieldguard::app
