@@ -21,7 +21,7 @@ namespace fieldguard::app {
 // Lengths in metres, angles in degrees (version 1 gave the box's yaw in radians as "yaw"). Its JSON Schema:
 // docs/obstacles.schema.json. "decision" when the safety monitor decided the frame (replay always does), with
 // "reason" "none" when it is go and "reasons" every active reason (safety_monitor.hpp).
-// A fused frame (fusion.hpp) adds, after "points_in":
+// A fused frame (fusion.hpp) adds, after "decision" (or "points_in"):
 //  "fusion":{"levelling":"full"|"attitude_only"|"none","rotations":n,"scan_points":n,"missing":["gnss",...],
 //            "timed_out":b,"dropped_points":n,"pose":{"easting":m,"northing":m,"up":m,"zone":z,"roll":deg,
 //            "pitch":deg,"yaw":deg}}   (pose when levelling is full; roll/pitch/yaw alone when attitude_only)
