@@ -227,7 +227,7 @@ std::string Session::status(Stamp now) const {
     const auto s = static_cast<safety::Sensor>(i);
     const auto k = kind_of(s);
     if (!enabled(cfg_, s)) {
-      off = static_cast<std::uint8_t>(off | (1U << static_cast<unsigned>(k)));
+      off = static_cast<std::uint8_t>(off | sync::bit(k));
       continue;
     }
     // Silence as the safety monitor judges it (every datagram of the 3D LiDAR counts, not only whole rotations).

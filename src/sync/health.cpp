@@ -47,7 +47,7 @@ std::string HealthMonitor::sensors_line(Stamp now, std::uint8_t off) const {
   for (SensorKind k : kAllSensors) {
     if (k != SensorKind::Lidar3d) s += ", ";
     s += to_string(k);
-    if ((off & (1U << index(k))) != 0) {
+    if ((off & bit(k)) != 0) {
       s += " off";
       continue;
     }
