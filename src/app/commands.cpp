@@ -117,6 +117,17 @@ Command add_replay(CLI::App& top) {
                   "zone and roll/pitch/yaw deg) and per obstacle \"plane\" [easting, northing, up] of its\n"
                   "footprint")
       ->type_name("FILE");
+  cmd->add_option("--mcap-out", opt->mcap_out,
+                  "run the detection pipeline and the safety monitor and record every frame into an MCAP\n"
+                  "file for Foxglove or Lichtblick, on the capture's timeline: the points as measured\n"
+                  "(/lidar/points) and as detection labelled them (/detection/points), the obstacle boxes\n"
+                  "(/detection/obstacles), the stop zone and ROI (/detection/zones), the decision\n"
+                  "(/safety/decision), and for a fused frame its pose (/tf) and position (/gnss/fix);\n"
+                  "Foxglove's schemas, JSON-encoded (docs/commands.md)")
+      ->type_name("FILE");
+  cmd->add_option("--mcap-compression", opt->mcap_compression, "the MCAP chunks' compression (default zstd)")
+      ->check(CLI::IsMember({"zstd", "lz4", "none"}))
+      ->type_name("zstd|lz4|none");
   cmd->add_option("--bev-dir", opt->bev_dir,
                   "write a bird's-eye PNG per frame (points by height, ground dimmed, obstacle boxes\n"
                   "with their distance, ROI and body box, 1 m grid)")
@@ -145,8 +156,9 @@ Command add_replay(CLI::App& top) {
       ->type_name("N");
   cmd->add_flag("--quiet", opt->quiet, "no progress line");
   return {cmd,
-          "fieldguard replay --config FILE (--pcap FILE | --session DIR) [--obstacles-out FILE] [--bev-dir DIR]\n"
-          "                         [--pcd-dir DIR] [--samples-out FILE] [--can-log FILE] [--workers N] [--quiet]",
+          "fieldguard replay --config FILE (--pcap FILE | --session DIR) [--obstacles-out FILE] [--mcap-out FILE]\n"
+          "                         [--bev-dir DIR] [--pcd-dir DIR] [--samples-out FILE] [--can-log FILE]\n"
+          "                         [--workers N] [--quiet]",
           [cmd, opt, workers] {
             if (const auto why = leftover(*cmd); !why.empty()) return usage_error(*cmd, why);
             if (opt->config.empty() || opt->pcap.has_value() == opt->session.has_value()) {
@@ -213,7 +225,8 @@ Command add_inspect(CLI::App& top) {
       "          After its frame, J1939 network management and diagnostics: \"j1939_address_claim\" (Address\n"
       "          Claimed, or Cannot Claim from 254): time iface sa cannot_claim name (hex) and the NAME's fields\n"
       "          identity_number manufacturer_code ecu_instance function_instance function vehicle_system\n"
-      "          vehicle_system_instance industry_group arbitrary_address_capable. \"j1939_dm1\" / \"j1939_dm2\": time\n"
+      "          vehicle_system_instance industry_group arbitrary_address_capable. \"j1939_dm1\" / \"j1939_dm2\": "
+      "time\n"
       "          iface sa lamps (malfunction red_stop amber_warning protect) dtcs (spn fmi occurrences) transport\n"
       "          (true: reassembled from BAM). \"j1939_bam\": any other message BAM completed: pgn size data.\n"
       "\n"

@@ -37,6 +37,7 @@
 #include "fieldguard/sync/ordered_pool.hpp"
 #include "fieldguard/sync/synchronizer.hpp"
 #include "fieldguard/writers/bev.hpp"
+#include "fieldguard/writers/mcap_recorder.hpp"
 #include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "fieldguard/writers/pcd_writer.hpp"
 #include "fieldguard/writers/png_writer.hpp"
@@ -148,6 +149,7 @@ class HeardTimes {
 struct Processed {
   DetectedFrame det;
   std::optional<Image> bev;  // rendered by the worker: it needs that worker's Pipeline::last_points()
+  std::vector<perception::LabeledPoint> labelled;  // that worker's last_points(), for the MCAP recording
 };
 
 using Pool = sync::OrderedPool<FrameJob, Processed>;
@@ -208,6 +210,7 @@ class Replay {
   std::string bev_dir_;
   std::ofstream obstacles_out_;
   std::optional<output::CandumpLogSink> can_log_;
+  std::optional<McapRecorder> mcap_;
   // Without --can-log the obstacles JSONL still carries each frame's decision: the stage decides into a sink that
   // sends nowhere, from a configuration without the J1939 address claim (nothing is on a bus to contest it).
   output::NullSink no_bus_;
@@ -273,7 +276,7 @@ bool Replay::open() {
   if (!open_outputs()) return false;
   fusion_.emplace(cfg_, FusionInputs{recording_->has(LogKind::Scan2d), recording_->has(LogKind::Gnss),
                                      recording_->has(LogKind::Ahrs)});
-  detect_ = obstacles_out_.is_open() || !bev_dir_.empty() || can_.has_value();
+  detect_ = obstacles_out_.is_open() || !bev_dir_.empty() || can_.has_value() || mcap_.has_value();
   // A fused frame needs the compensation even when only its points are written.
   if (detect_ || fusion_->fused()) detectors_.emplace(cfg_, workers_);
   sync::PoolParams pool_params;
@@ -306,6 +309,17 @@ bool Replay::open_outputs() {
       return false;
     }
   }
+  if (const auto& m = opt_.mcap_out) {
+    McapOptions o;
+    o.compression = opt_.mcap_compression == "lz4"    ? McapCompression::Lz4
+                    : opt_.mcap_compression == "none" ? McapCompression::None
+                                                      : McapCompression::Zstd;
+    mcap_.emplace(cfg_);
+    if (!mcap_->open(*m, o)) {
+      std::fprintf(stderr, "fieldguard replay: %s\n", mcap_->error().c_str());
+      return false;
+    }
+  }
   if (const auto& c = opt_.can_log) {
     try {
       can_log_.emplace(*c, cfg_.can.interface);
@@ -314,7 +328,7 @@ bool Replay::open_outputs() {
       std::fprintf(stderr, "fieldguard replay: --can-log: %s\n", e.what());
       return false;
     }
-  } else if (obstacles_out_.is_open()) {
+  } else if (obstacles_out_.is_open() || mcap_) {
     decide_cfg_ = cfg_;
     decide_cfg_->can.j1939.address_claim = false;
     can_.emplace(*decide_cfg_, no_bus_);
@@ -327,6 +341,7 @@ bool Replay::open_outputs() {
 // depend on the number of workers.
 void Replay::process(FrameJob& job, Processed& out) {
   out.bev.reset();
+  out.labelled.clear();
   if (!detectors_) {
     std::swap(out.det.frame, job.rotation);
     out.det.result = perception::FrameResult{};
@@ -337,6 +352,10 @@ void Replay::process(FrameJob& job, Processed& out) {
   detector->process(job, out.det, detect_);
   if (!bev_dir_.empty()) {
     out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg_.perception, std::nullopt);
+  }
+  if (mcap_ && detect_) {
+    const auto points = detector->pipeline().last_points();
+    out.labelled.assign(points.begin(), points.end());
   }
 }
 
@@ -390,6 +409,10 @@ void Replay::write_frame(const Pool::Result& r) {
     obstacles_out_ << obstacles_json_line(f, result, fused, &cfg_.lidar.mounting, decision, cfg_.safety.clear_frames)
                    << '\n';
     if (!obstacles_out_) write_error_ = "cannot write " + *opt_.obstacles_out;
+  }
+  if (mcap_ && write_error_.empty()) {
+    const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
+    if (!mcap_->frame(f, result, r.output->labelled, fused, decision)) write_error_ = mcap_->error();
   }
   if (r.output->bev && write_error_.empty()) {
     write_error_ = write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string(), *r.output->bev);
@@ -571,6 +594,13 @@ int Replay::finish() {
   }
   print_fusion_summary();
   if (samples_) samples_->finish();
+  if (mcap_) {
+    if (!mcap_->close() && write_error_.empty()) write_error_ = mcap_->error();
+    const McapStats& m = mcap_->stats();
+    std::printf("  mcap              %llu messages, %llu chunks, %.1f MB (%.1f MB before compression)\n",
+                static_cast<unsigned long long>(m.messages), static_cast<unsigned long long>(m.chunks),
+                static_cast<double>(m.file_bytes) * 1e-6, static_cast<double>(m.uncompressed_bytes) * 1e-6);
+  }
 
   if (pcap_stats.truncated)
     log_->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path_);
