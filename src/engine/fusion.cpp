@@ -81,7 +81,7 @@ DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
   return d;
 }
 
-void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
+void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect, bool keep_labelled) {
   d.started = wall_clock_now();
   const bool rotation = !job.synced;
   if (rotation) {
@@ -93,6 +93,7 @@ void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
   }
   d.compensated = wall_clock_now();
   if (!detect) {
+    d.labelled.clear();
     d.result = perception::FrameResult{};
     d.finished = d.compensated;
     return;
@@ -104,6 +105,11 @@ void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect) {
     throw;
   }
   d.finished = wall_clock_now();
+  d.labelled.clear();
+  if (keep_labelled) {
+    const auto points = pipeline_.last_points();
+    d.labelled.assign(points.begin(), points.end());  // into the slot's earlier buffer: no allocation once warm
+  }
 }
 
 void FrameDetector::compensate(const sync::SyncedFrame& sf, DetectedFrame& d) {

@@ -149,7 +149,6 @@ class HeardTimes {
 struct Processed {
   DetectedFrame det;
   std::optional<Image> bev;  // rendered by the worker: it needs that worker's Pipeline::last_points()
-  std::vector<perception::LabeledPoint> labelled;  // that worker's last_points(), for the MCAP recording
 };
 
 using Pool = sync::OrderedPool<FrameJob, Processed>;
@@ -310,12 +309,11 @@ bool Replay::open_outputs() {
     }
   }
   if (const auto& m = opt_.mcap_out) {
-    McapOptions o;
-    o.compression = opt_.mcap_compression == "lz4"    ? McapCompression::Lz4
-                    : opt_.mcap_compression == "none" ? McapCompression::None
-                                                      : McapCompression::Zstd;
+    McapRecording rec;
+    rec.path = *m;
+    rec.options.compression = mcap_compression(opt_.mcap_compression).value_or(McapCompression::Zstd);
     mcap_.emplace(cfg_);
-    if (!mcap_->open(*m, o)) {
+    if (!mcap_->open(rec)) {
       std::fprintf(stderr, "fieldguard replay: %s\n", mcap_->error().c_str());
       return false;
     }
@@ -341,7 +339,6 @@ bool Replay::open_outputs() {
 // depend on the number of workers.
 void Replay::process(FrameJob& job, Processed& out) {
   out.bev.reset();
-  out.labelled.clear();
   if (!detectors_) {
     std::swap(out.det.frame, job.rotation);
     out.det.result = perception::FrameResult{};
@@ -349,13 +346,9 @@ void Replay::process(FrameJob& job, Processed& out) {
     return;
   }
   const DetectorSet::Lease detector(*detectors_);
-  detector->process(job, out.det, detect_);
+  detector->process(job, out.det, detect_, mcap_.has_value());
   if (!bev_dir_.empty()) {
     out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg_.perception, std::nullopt);
-  }
-  if (mcap_ && detect_) {
-    const auto points = detector->pipeline().last_points();
-    out.labelled.assign(points.begin(), points.end());
   }
 }
 
@@ -412,7 +405,7 @@ void Replay::write_frame(const Pool::Result& r) {
   }
   if (mcap_ && write_error_.empty()) {
     const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
-    if (!mcap_->frame(f, result, r.output->labelled, fused, decision)) write_error_ = mcap_->error();
+    if (!mcap_->frame(f, result, r.output->det.labelled, fused, decision)) write_error_ = mcap_->error();
   }
   if (r.output->bev && write_error_.empty()) {
     write_error_ = write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string(), *r.output->bev);
@@ -596,10 +589,9 @@ int Replay::finish() {
   if (samples_) samples_->finish();
   if (mcap_) {
     if (!mcap_->close() && write_error_.empty()) write_error_ = mcap_->error();
-    const McapStats& m = mcap_->stats();
-    std::printf("  mcap              %llu messages, %llu chunks, %.1f MB (%.1f MB before compression)\n",
-                static_cast<unsigned long long>(m.messages), static_cast<unsigned long long>(m.chunks),
-                static_cast<double>(m.file_bytes) * 1e-6, static_cast<double>(m.uncompressed_bytes) * 1e-6);
+    const McapRecorderStats m = mcap_->stats();
+    std::printf("  mcap              %llu frames, %llu messages, %.1f MB\n", static_cast<unsigned long long>(m.frames),
+                static_cast<unsigned long long>(m.messages), static_cast<double>(m.bytes) * 1e-6);
   }
 
   if (pcap_stats.truncated)

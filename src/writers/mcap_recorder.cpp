@@ -1,78 +1,97 @@
 #include "fieldguard/writers/mcap_recorder.hpp"
 
-#include <algorithm>
-#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <system_error>
 
 #include "fieldguard/core/version.hpp"
 #include "fieldguard/writers/foxglove_json.hpp"
 
 namespace fieldguard::app {
 
-McapRecorder::McapRecorder(const Config& cfg) : cfg_(cfg), projection_(cfg.geo.projection) {}
+McapRecorder::McapRecorder(const Config& cfg) : encoder_(cfg) {}
 
-bool McapRecorder::open(const std::string& path, const McapOptions& options) {
-  McapOptions o = options;
-  if (o.library.empty()) o.library = std::string("fieldguard ") + version_string();
-  if (!writer_.open(path, o)) return false;
-  schema_ids_.assign(foxglove::schemas().size(), 0);
-  auto channel = [&](std::string_view topic, std::string_view schema_name) {
-    const foxglove::Schema& s = foxglove::schema(schema_name);
-    // One schema record per schema, however many channels use it.
-    for (std::size_t i = 0; i < foxglove::schemas().size(); ++i) {
-      if (foxglove::schemas()[i].name == schema_name) {
-        if (schema_ids_[i] == 0) schema_ids_[i] = writer_.add_schema(s.name, "jsonschema", s.json);
-        return writer_.add_channel(schema_ids_[i], topic, "json");
-      }
-    }
-    return std::uint16_t{0};
-  };
-  ch_.raw = channel("/lidar/points", "foxglove.PointCloud");
-  ch_.labelled = channel("/detection/points", "foxglove.PointCloud");
-  ch_.obstacles = channel("/detection/obstacles", "foxglove.SceneUpdate");
-  ch_.zones = channel("/detection/zones", "foxglove.SceneUpdate");
-  ch_.decision = channel("/safety/decision", "fieldguard.Decision");
-  ch_.tf = channel("/tf", "foxglove.FrameTransform");
-  ch_.fix = channel("/gnss/fix", "foxglove.LocationFix");
-  return writer_.error().empty();
+std::string McapRecorder::numbered(const std::string& path, std::uint64_t index) {
+  const std::filesystem::path p(path);
+  char n[24];
+  std::snprintf(n, sizeof n, "_%04llu", static_cast<unsigned long long>(index));
+  return (p.parent_path() / (p.stem().string() + n + p.extension().string())).string();
 }
 
-bool McapRecorder::put(std::uint16_t channel, std::int64_t stamp_ns) {
-  return writer_.write(channel, static_cast<std::uint64_t>(std::max<std::int64_t>(stamp_ns, 0)), message_);
+bool McapRecorder::open(const McapRecording& recording) {
+  rec_ = recording;
+  if (rec_.options.library.empty()) rec_.options.library = std::string("fieldguard ") + version_string();
+  return open_next();
+}
+
+bool McapRecorder::open_next() {
+  if (writer_) {
+    if (!writer_->close()) error_ = writer_->error();
+    done_.messages += writer_->stats().messages;
+    done_.bytes += writer_->stats().file_bytes;
+    writer_.reset();
+    if (!error_.empty()) return false;
+  }
+  ++done_.files;
+  current_ = rec_.max_bytes == 0 ? rec_.path : numbered(rec_.path, done_.files);
+  writer_ = std::make_unique<McapWriter>();
+  if (!writer_->open(current_, rec_.options)) {
+    error_ = writer_->error();
+    return false;
+  }
+  // Only the newest max_files stay: the one max_files before this one goes now.
+  if (rec_.max_bytes != 0 && rec_.max_files > 0 && done_.files > static_cast<std::uint64_t>(rec_.max_files)) {
+    std::error_code ec;
+    if (std::filesystem::remove(numbered(rec_.path, done_.files - static_cast<std::uint64_t>(rec_.max_files)), ec))
+      ++done_.removed;
+  }
+  // One schema record per schema, however many channels use it.
+  std::vector<std::uint16_t> schema_ids(foxglove::schemas().size(), 0);
+  channels_.clear();
+  for (const FrameChannel& c : kFrameChannels) {
+    for (std::size_t i = 0; i < foxglove::schemas().size(); ++i) {
+      const foxglove::Schema& s = foxglove::schemas()[i];
+      if (s.name != c.schema) continue;
+      if (schema_ids[i] == 0) schema_ids[i] = writer_->add_schema(s.name, "jsonschema", s.json);
+      channels_.push_back(writer_->add_channel(schema_ids[i], c.topic, "json"));
+    }
+  }
+  if (!writer_->error().empty()) error_ = writer_->error();
+  return error_.empty();
 }
 
 bool McapRecorder::frame(const LidarFrame& frame, const perception::FrameResult& result,
                          std::span<const perception::LabeledPoint> points, const FusionInfo* fusion,
                          const output::safety::Decision* decision) {
-  const std::int64_t t = frame.host_stamp.ns;
-  // The detection frame's z = 0 is the sensor: the ground drawn at the mounting height below it.
-  const double ground_z = -cfg_.perception.ground.zones.sensor_height_m;
-  foxglove::raw_cloud(message_, t, frame);
-  put(ch_.raw, t);
-  foxglove::labelled_cloud(message_, t, points, result.obstacles);
-  put(ch_.labelled, t);
-  foxglove::obstacles_scene(message_, t, result.obstacles, decision != nullptr ? &decision->zone : nullptr);
-  put(ch_.obstacles, t);
-  foxglove::zones_scene(message_, t, cfg_.perception.roi, cfg_.perception.body, ground_z, decision);
-  put(ch_.zones, t);
-  if (decision != nullptr) {
-    foxglove::decision(message_, t, frame.index, *decision, cfg_.safety.clear_frames);
-    put(ch_.decision, t);
-  }
-  if (fusion != nullptr) {
-    if (const auto pose = detection_pose(*fusion, cfg_.lidar.mounting)) {
-      if (!origin_)
-        origin_ = std::array<double, 3>{std::round(pose->x_m), std::round(pose->y_m), std::round(pose->z_m)};
-      foxglove::frame_transform(message_, t, *pose, *origin_);
-      put(ch_.tf, t);
-      if (const auto g = projection_.reverse(*fusion->reference)) {
-        foxglove::location_fix(message_, t, *g);
-        put(ch_.fix, t);
-      }
-    }
-  }
-  return writer_.error().empty();
+  if (!error_.empty() || !writer_) return false;
+  // A bounded recording starts its next file at a frame, so that each file holds whole frames.
+  if (rec_.max_bytes != 0 && writer_->size_bound() >= rec_.max_bytes && !open_next()) return false;
+  encoder_.encode(frame, result, points, fusion, decision, [this](Topic topic, std::int64_t t, std::string_view json) {
+    writer_->write(channels_[static_cast<std::size_t>(topic)], static_cast<std::uint64_t>(std::max<std::int64_t>(t, 0)),
+                   json);
+  });
+  ++frames_;
+  if (!writer_->error().empty()) error_ = writer_->error();
+  return error_.empty();
 }
 
-bool McapRecorder::close() { return writer_.close(); }
+bool McapRecorder::close() {
+  if (!writer_) return error_.empty();
+  if (!writer_->close() && error_.empty()) error_ = writer_->error();
+  done_.messages += writer_->stats().messages;
+  done_.bytes += writer_->stats().file_bytes;
+  writer_.reset();
+  return error_.empty();
+}
+
+McapRecorderStats McapRecorder::stats() const {
+  McapRecorderStats s = done_;
+  s.frames = frames_;
+  if (writer_) {
+    s.messages += writer_->stats().messages;
+    s.bytes += writer_->stats().file_bytes;
+  }
+  return s;
+}
 
 }  // namespace fieldguard::app

@@ -74,6 +74,13 @@ const char* to_string(McapCompression c) {
   return "";
 }
 
+std::optional<McapCompression> mcap_compression(std::string_view word) {
+  if (word == "zstd") return McapCompression::Zstd;
+  if (word == "lz4") return McapCompression::Lz4;
+  if (word == "none") return McapCompression::None;
+  return std::nullopt;
+}
+
 McapWriter::McapWriter() = default;
 
 McapWriter::~McapWriter() {

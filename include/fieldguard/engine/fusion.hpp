@@ -88,6 +88,9 @@ struct DetectedFrame {
   LidarFrame frame;
   perception::FrameResult result;
   std::optional<FusionInfo> fusion;  // fused mode
+  // The points detection worked on, labelled (Pipeline::last_points()), when the caller asked for them: a view
+  // of the frame needs them after the worker's pipeline has moved on.
+  std::vector<perception::LabeledPoint> labelled;
   // Wall-clock times on the worker, the worker's share of the frame's latency: taken up, compensated (= started
   // for a rotation), detected.
   Stamp started;
@@ -98,12 +101,12 @@ struct DetectedFrame {
 class FrameDetector {
  public:
   explicit FrameDetector(const Config& cfg);
-  // detect = false: compensation only (points to write).
+  // detect = false: compensation only (points to write). keep_labelled: d.labelled gets the labelled points.
   [[nodiscard]] DetectedFrame process(FrameJob& job, bool detect = true);
   // The same into `d`, an earlier frame's result whose buffers are reused: once warm, nothing is allocated. The
   // job keeps its own points (a fused frame's raw points; a rotation's trade places with d's earlier points), for
   // the producer to recycle (SensorFusion::recycle()).
-  void process(FrameJob& job, DetectedFrame& d, bool detect = true);
+  void process(FrameJob& job, DetectedFrame& d, bool detect = true, bool keep_labelled = false);
   [[nodiscard]] const perception::Pipeline& pipeline() const { return pipeline_; }
 
  private:

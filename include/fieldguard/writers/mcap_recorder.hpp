@@ -1,65 +1,70 @@
 #pragma once
-// Processed frames into an MCAP file on one timeline (each message's log time is its frame's time), on the
-// channels a Foxglove or Lichtblick layout subscribes to:
-//   /lidar/points          foxglove.PointCloud    the frame's points as measured (intensity, ring, source)
-//   /detection/points      foxglove.PointCloud    what detection made of them (label, obstacle index)
-//   /detection/obstacles   foxglove.SceneUpdate   the obstacle boxes with their distances
-//   /detection/zones       foxglove.SceneUpdate   the stop zone (coloured by the decision), ROI and body box
-//   /safety/decision       fieldguard.Decision    stop or go, the reasons, the headline
-//   /tf                    foxglove.FrameTransform field -> lidar, for a fused frame levelled in full
-//   /gnss/fix              foxglove.LocationFix   that frame's reference point in WGS84
-// Thread-compatible: the thread that delivers frames in order writes them.
+// Processed frames into MCAP files on one timeline (each message's log time is its frame's time), on the
+// channels of frame_messages.hpp. One file, or (live, where a recording must not fill the disk) a series of
+// files of a bounded size of which the newest few are kept: PATH's stem + _NNNN + its extension, each a whole
+// MCAP file that starts at a frame. Thread-compatible: one thread records.
 
-#include <array>
 #include <cstdint>
-#include <optional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/engine/fusion.hpp"
-#include "fieldguard/geo/projection.hpp"
 #include "fieldguard/output/safety_monitor.hpp"
+#include "fieldguard/writers/frame_messages.hpp"
 #include "fieldguard/writers/mcap_writer.hpp"
 
 namespace fieldguard::app {
+
+struct McapRecording {
+  std::string path;
+  McapOptions options;
+  std::uint64_t max_bytes = 0;  // 0: one file at `path`, however large; else a new file once one is this large
+  int max_files = 0;            // with max_bytes: the newest this many files are kept (0: every one)
+};
+
+struct McapRecorderStats {
+  std::uint64_t frames = 0;
+  std::uint64_t messages = 0;
+  std::uint64_t bytes = 0;    // written, every file
+  std::uint64_t files = 0;    // opened
+  std::uint64_t removed = 0;  // old files removed to keep max_files
+};
 
 class McapRecorder {
  public:
   explicit McapRecorder(const Config& cfg);
 
-  // Opens the file and writes the schemas and channels. False with error() set when it cannot.
-  bool open(const std::string& path, const McapOptions& options);
-  // One frame: `points` are the labelled points detection worked on (empty when detection did not run),
-  // `decision` the safety monitor's for this frame (none when nothing decided). False with error() set when
-  // the file cannot be written.
+  // Opens the (first) file and writes the schemas and channels. False with error() set when it cannot.
+  bool open(const McapRecording& recording);
+  // One frame (FrameEncoder::encode). False with error() set when a file cannot be written; nothing more is
+  // written then.
   bool frame(const LidarFrame& frame, const perception::FrameResult& result,
              std::span<const perception::LabeledPoint> points, const FusionInfo* fusion,
              const output::safety::Decision* decision);
+  // The summary and footer of the file being written.
   bool close();
 
-  [[nodiscard]] const std::string& error() const { return writer_.error(); }
-  [[nodiscard]] const McapStats& stats() const { return writer_.stats(); }
+  [[nodiscard]] const std::string& error() const { return error_; }
+  [[nodiscard]] McapRecorderStats stats() const;
+  // The file being written (or the last one).
+  [[nodiscard]] const std::string& current_path() const { return current_; }
+  // The name of the `index`th file of a bounded recording (from 1).
+  [[nodiscard]] static std::string numbered(const std::string& path, std::uint64_t index);
 
  private:
-  bool put(std::uint16_t channel, std::int64_t stamp_ns);
+  bool open_next();
 
-  const Config& cfg_;
-  McapWriter writer_;
-  geo::GaussKrueger projection_;
-  std::string message_;                    // scratch: one message's JSON
-  std::vector<std::uint16_t> schema_ids_;  // by foxglove::schemas() index; 0 until written
-  struct Channels {
-    std::uint16_t raw = 0;
-    std::uint16_t labelled = 0;
-    std::uint16_t obstacles = 0;
-    std::uint16_t zones = 0;
-    std::uint16_t decision = 0;
-    std::uint16_t tf = 0;
-    std::uint16_t fix = 0;
-  } ch_;
-  std::optional<std::array<double, 3>> origin_;  // of the "field" frame: the first full pose, whole metres
+  FrameEncoder encoder_;
+  McapRecording rec_;
+  std::unique_ptr<McapWriter> writer_;
+  std::vector<std::uint16_t> channels_;  // by Topic
+  std::string error_;
+  std::string current_;
+  McapRecorderStats done_;  // of the files closed
+  std::uint64_t frames_ = 0;
 };
 
 }  // namespace fieldguard::app

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -24,6 +25,8 @@ namespace fieldguard::app {
 enum class McapCompression : std::uint8_t { None = 0, Zstd = 1, Lz4 = 2 };
 // "zstd", "lz4", "" (the names the specification's registry gives; "" is stored).
 [[nodiscard]] const char* to_string(McapCompression c);
+// "zstd", "lz4" or "none" (the command line's and the configuration's words); nothing for another word.
+[[nodiscard]] std::optional<McapCompression> mcap_compression(std::string_view word);
 
 struct McapOptions {
   McapCompression compression = McapCompression::Zstd;
@@ -74,6 +77,8 @@ class McapWriter {
 
   [[nodiscard]] const std::string& error() const { return error_; }
   [[nodiscard]] const McapStats& stats() const { return stats_; }
+  // The file's size were it closed now, at most: what is written, and the chunk being built uncompressed.
+  [[nodiscard]] std::uint64_t size_bound() const { return stats_.file_bytes + chunk_.size(); }
 
  private:
   struct Schema {
