@@ -409,9 +409,9 @@ LoadResult load(const std::string& text, const std::string& name, const std::str
     result.issues.push_back({name, 0, "", "the file is empty; start from config/fieldguard.yaml"});
     return result;
   }
-  if (r.section(
-          root, "",
-          {"lidar", "scan2d", "gnss", "ahrs", "sync", "geo", "perception", "safety", "pipeline", "realtime", "can"})) {
+  if (r.section(root, "",
+                {"lidar", "scan2d", "gnss", "ahrs", "sync", "geo", "perception", "safety", "pipeline", "realtime",
+                 "can", "view"})) {
     read_lidar(r, root["lidar"], config_dir, result.config.lidar);
     read_scan2d(r, root["scan2d"], result.config.scan2d);
     read_gnss(r, root["gnss"], result.config.gnss);
@@ -423,6 +423,7 @@ LoadResult load(const std::string& text, const std::string& name, const std::str
     read_pipeline(r, root["pipeline"], result.config.pipeline);
     read_realtime(r, root["realtime"], result.config.realtime);
     read_can(r, root["can"], config_dir, result.config.can);
+    read_view(r, root["view"], config_dir, result.config.view);
     // The zone ground starts from the ground below the sensor: the LiDAR's mounting height when the file
     // gives one (otherwise ZoneParams' default, 0.95 m).
     auto& cfg = result.config;

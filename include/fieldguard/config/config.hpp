@@ -80,6 +80,7 @@ struct Config {
   PipelineConfig pipeline;        // the perception worker pool
   RealtimeConfig realtime;        // the daemon's threads: scheduling, affinity, locked memory, latency budget
   CanConfig can;                  // the CAN output
+  ViewConfig view;                // the MCAP recording and the live server (off by default)
 };
 
 // One problem found in a configuration file.

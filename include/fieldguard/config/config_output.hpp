@@ -68,4 +68,24 @@ struct CanConfig {
   J1939Config j1939;
 };
 
+// What the daemon shows of what it sees (`view:`): an MCAP recording of its frames and a live server for
+// Foxglove (the Foxglove WebSocket protocol) and a browser (the status page), both off by default. Neither can
+// slow detection: frames reach them through a bounded queue, and a frame that finds it full is dropped there
+// (counted), never held up.
+struct ViewConfig {
+  // The recording (writers/mcap_recorder.hpp): a series of MCAP files of at most max_mb each, the newest
+  // max_files kept. "" = none; a relative path is taken from the config file's folder.
+  std::string mcap_path;
+  std::string mcap_compression = "zstd";  // zstd | lz4 | none
+  int mcap_max_mb = 1024;
+  int mcap_max_files = 8;
+  // The server: HTTP (status page) and the Foxglove WebSocket protocol on one port.
+  bool server = false;
+  std::string address = "127.0.0.1";  // localhost unless the integrator opens it to the vehicle's network
+  std::uint16_t port = 8765;          // Foxglove's default
+  int max_clients = 4;
+  int client_queue = 64;  // messages waiting for one client; beyond, that client's oldest are dropped (counted)
+  int queue_frames = 2;   // frames waiting for the view's thread; beyond, a frame is not shown (counted)
+};
+
 }  // namespace fieldguard::app
