@@ -320,13 +320,19 @@ Command add_run(CLI::App& top) {
       "Under systemd (Type=notify): READY=1 once every required sensor has been heard, WATCHDOG=1 fed by the\n"
       "decisions (none while rotations wait in the pipeline longer than safety.max_frame_interval_s), STATUS=\n"
       "a one-line health summary.\n"
+      "With `view:` (off by default) it records MCAP files and serves a status page and the Foxglove\n"
+      "WebSocket protocol on view.server.port; neither can delay a decision (docs/view.md).\n"
       "Exit code 0 after a signal, 2 for an unusable configuration or a sensor port that cannot be opened.\n");
   cmd->add_option("--config", opt->config, kConfigHelp)->type_name("FILE");
   cmd->add_option("--can-log", opt->can_log,
                   "write the CAN frames to this candump -L log instead of the configured sink")
       ->type_name("FILE");
+  cmd->add_option("--mcap-out", opt->mcap_out,
+                  "record the frames for Foxglove as view.mcap.path does, to this path instead: FILE's stem\n"
+                  "_0001, _0002, ... (view.mcap.max_mb each, the newest view.mcap.max_files kept)")
+      ->type_name("FILE");
   cmd->add_flag("--quiet", opt->quiet, "no summary on exit");
-  return {cmd, "fieldguard run --config FILE [--can-log FILE] [--quiet]", [cmd, opt] {
+  return {cmd, "fieldguard run --config FILE [--can-log FILE] [--mcap-out FILE] [--quiet]", [cmd, opt] {
             if (const auto why = leftover(*cmd); !why.empty()) return usage_error(*cmd, why);
             if (opt->config.empty()) return usage_error(*cmd, "--config is required");
             return run_daemon(*opt);

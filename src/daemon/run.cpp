@@ -112,6 +112,7 @@ bool Daemon::open() {
     std::fprintf(stderr, "fieldguard run: invalid configuration %s\n", opt_.config.c_str());
     return false;
   }
+  if (opt_.mcap_out) loaded.config.view.mcap_path = *opt_.mcap_out;
   key_ = sink_key(loaded.config, opt_.can_log);
   try {
     set_link(make_sink(key_), loaded.config);
@@ -211,6 +212,7 @@ void Daemon::reload() {
     notify_.reloaded(session_->status(wall_clock_now()));
     return;
   }
+  if (opt_.mcap_out) fresh.config.view.mcap_path = *opt_.mcap_out;
   const Config old = session_->config();
   const SinkKey new_key = sink_key(fresh.config, opt_.can_log);
   session_.reset();

@@ -72,6 +72,17 @@ void Session::start() {
   o.port = cfg_.lidar.data_port;
   udp_ = std::make_unique<io::UdpReceiver>(io_, o, [this](const io::UdpDatagram& d) { on_datagram(d); });
   udp_->start();
+  if (view_wanted_) {
+    view_ = std::make_unique<LiveView>(cfg_);  // throws when the recording or the port cannot be opened
+    if (!cfg_.view.mcap_path.empty()) {
+      log_->info("recording to {} (MCAP, files of at most {} MB, the newest {} kept)", cfg_.view.mcap_path,
+                 cfg_.view.mcap_max_mb, cfg_.view.mcap_max_files);
+    }
+    if (const auto port = view_->port()) {
+      log_->info("live view on http://{}:{}/ (status page; Foxglove: ws://{}:{})", cfg_.view.address, *port,
+                 cfg_.view.address, *port);
+    }
+  }
   log_->info("listening for the 3D LiDAR on udp port {}; {}", udp_->local_port(),
              fusion_.fused() ? "frames fused from every enabled sensor at " + std::to_string(cfg_.sync.rate_hz) + " Hz"
                              : std::string("one frame per rotation"));
@@ -201,6 +212,7 @@ void Session::on_tick(std::chrono::nanoseconds late) {
   } else if (SteadyClock::now() - last_status_ >= kStatusEvery) {
     last_status_ = SteadyClock::now();
     notify_.status(status(now));
+    if (view_) view_->sensors(view_sensors(now), status(now));
     // With the status, and only between frames: the pool's slots a burst filled (frames released together after
     // a sensor outage) give their buffers back; a steady stream reuses no more than one per worker.
     trimmed_slots_ +=
@@ -212,6 +224,30 @@ void Session::on_tick(std::chrono::nanoseconds late) {
     trimmed_spares_ += fusion_.trim_spares();
   }
   if (!stalled && ready_) notify_.progress(SteadyClock::now());
+}
+
+std::vector<ViewSensor> Session::view_sensors(Stamp now) const {
+  std::vector<ViewSensor> out;
+  for (std::size_t i = 0; i < safety::kSensorCount; ++i) {
+    const auto s = static_cast<safety::Sensor>(i);
+    ViewSensor v;
+    v.name = safety::to_string(s);
+    v.rate_hz = health_.rate_hz(kind_of(s), now);
+    const Stamp last = stage_.last_data(s);
+    if (!enabled(cfg_, s)) {
+      v.state = "off";
+    } else if (last.ns == 0) {
+      v.state = "never heard";
+    } else if (const double age = static_cast<double>(now.ns - last.ns) * 1e-9; age > cfg_.safety.sensor(s).timeout_s) {
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "silent %.1f s", age);
+      v.state = buf;
+    } else {
+      v.state = "ok";
+    }
+    out.push_back(std::move(v));
+  }
+  return out;
 }
 
 std::string Session::status(Stamp now) const {
@@ -313,6 +349,15 @@ void Session::print_summary() const {
     }
     std::printf("%s (median, p99 ms)\n", line.c_str());
   }
+  if (view_) {
+    const LiveViewCounts v = view_->counts();
+    std::printf(
+        "  view              %llu frames, %llu not shown (queue full); mcap %llu frames, %llu files, %.1f MB%s; "
+        "server %llu connections, %llu refused, %llu messages sent, %llu dropped, %llu bad client messages\n",
+        u(v.frames), u(v.dropped), u(v.mcap.frames), u(v.mcap.files), static_cast<double>(v.mcap.bytes) * 1e-6,
+        v.mcap_errors != 0 ? " (failed)" : "", u(v.server.connections), u(v.server.refused), u(v.server.sent),
+        u(v.server.dropped), u(v.server.bad_messages));
+  }
   std::printf("  io loop           longest gap %.3f ms (a due timer waited that long for the io thread)\n",
               ms(io_gap_.max_ns()));
   if (alloc::enabled()) {
@@ -355,7 +400,7 @@ sync::PoolParams Session::pool_params(const Config& c, boost::asio::io_context& 
 void Session::process(FrameJob& j, DetectedFrame& d) {
   const alloc::Scope frame_path(alloc::Path::Frame);
   const DetectorSet::Lease detector(detectors_);
-  detector->process(j, d);
+  detector->process(j, d, true, view_wanted_);
 }
 
 void Session::heard(safety::Sensor s, Stamp t) {
@@ -446,6 +491,8 @@ void Session::deliver(const Pool::Result& r) {
         "is said once)",
         static_cast<double>(latency_ns) * 1e-6, cfg_.realtime.latency_budget_ms);
   }
+  // After the stop request is written, so that showing a frame is never part of deciding it.
+  if (view_ && stage_.last_decision()) view_->frame(*r.output, *stage_.last_decision());
   if (ready_) notify_.progress(SteadyClock::now());
   if (!warm_frame_allocs_ && stage_.counts().frames >= kWarmFrames) {
     warm_frame_allocs_ = alloc::count(alloc::Path::Frame);

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/live_view.hpp"
 #include "daemon/run_stage.hpp"
 #include "daemon/systemd_notify.hpp"
 #include "fieldguard/config/config.hpp"
@@ -69,6 +70,8 @@ class Session {
   void on_tick(std::chrono::nanoseconds late = {});
 
   [[nodiscard]] std::string status(Stamp now) const;
+  // The live view's port (view.server, when on): the one the kernel chose for port 0.
+  [[nodiscard]] std::optional<std::uint16_t> view_port() const { return view_ ? view_->port() : std::nullopt; }
 
   // Also what tools/fieldguard-load reads: keep the labels stable.
   void print_summary() const;
@@ -92,6 +95,8 @@ class Session {
   void process(FrameJob& j, DetectedFrame& d);  // over the slot's earlier result (OrderedPool::ProcessInto)
 
   void heard(output::safety::Sensor s, Stamp t);
+  // Each sensor's state and rate, for the live view's page.
+  [[nodiscard]] std::vector<ViewSensor> view_sensors(Stamp now) const;
 
   void on_datagram(const io::UdpDatagram& d);
   // Implausible GNSS / AHRS samples decoded since the last decision go to the next one.
@@ -101,6 +106,7 @@ class Session {
 
   boost::asio::io_context& io_;
   const Config cfg_;
+  const bool view_wanted_ = LiveView::wanted(cfg_);  // the workers keep each frame's labelled points for it
   SystemdNotifier& notify_;
   bool& ready_;
   std::shared_ptr<spdlog::logger> log_ = logger("run");
@@ -146,6 +152,7 @@ class Session {
   SteadyClock::time_point last_status_{};
   std::uint64_t trimmed_slots_ = 0;   // pool slots whose buffers went back (OrderedPool::trim_idle)
   std::uint64_t trimmed_spares_ = 0;  // spare buffers freed (SensorFusion::trim_spares)
+  std::unique_ptr<LiveView> view_;    // view: the recording and the live server; made by start()
 };
 
 }  // namespace fieldguard::app

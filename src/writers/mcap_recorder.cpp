@@ -1,5 +1,6 @@
 #include "fieldguard/writers/mcap_recorder.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
@@ -63,16 +64,27 @@ bool McapRecorder::open_next() {
 bool McapRecorder::frame(const LidarFrame& frame, const perception::FrameResult& result,
                          std::span<const perception::LabeledPoint> points, const FusionInfo* fusion,
                          const output::safety::Decision* decision) {
+  if (!begin_frame()) return false;
+  encoder_.encode(frame, result, points, fusion, decision,
+                  [this](Topic topic, std::int64_t t, std::string_view json) { message(topic, t, json); });
+  if (!writer_->error().empty()) error_ = writer_->error();
+  return error_.empty();
+}
+
+bool McapRecorder::begin_frame() {
   if (!error_.empty() || !writer_) return false;
   // A bounded recording starts its next file at a frame, so that each file holds whole frames.
   if (rec_.max_bytes != 0 && writer_->size_bound() >= rec_.max_bytes && !open_next()) return false;
-  encoder_.encode(frame, result, points, fusion, decision, [this](Topic topic, std::int64_t t, std::string_view json) {
-    writer_->write(channels_[static_cast<std::size_t>(topic)], static_cast<std::uint64_t>(std::max<std::int64_t>(t, 0)),
-                   json);
-  });
   ++frames_;
-  if (!writer_->error().empty()) error_ = writer_->error();
-  return error_.empty();
+  return true;
+}
+
+void McapRecorder::message(Topic topic, std::int64_t stamp_ns, std::string_view json) {
+  if (!error_.empty() || !writer_) return;
+  if (!writer_->write(channels_[static_cast<std::size_t>(topic)],
+                      static_cast<std::uint64_t>(std::max<std::int64_t>(stamp_ns, 0)), json)) {
+    error_ = writer_->error();
+  }
 }
 
 bool McapRecorder::close() {

@@ -106,7 +106,7 @@ void Image::text(int x, int y, const std::string& s, Rgb c) {
   }
 }
 
-std::string write_png(const std::string& path, const Image& image) {
+std::vector<std::uint8_t> encode_png(const Image& image) {
   const auto w = static_cast<std::size_t>(image.width());
   const auto h = static_cast<std::size_t>(image.height());
   std::vector<std::uint8_t> raw;
@@ -118,9 +118,7 @@ std::string write_png(const std::string& path, const Image& image) {
   }
   uLongf packed_size = compressBound(static_cast<uLong>(raw.size()));
   std::vector<std::uint8_t> packed(packed_size);
-  if (compress2(packed.data(), &packed_size, raw.data(), static_cast<uLong>(raw.size()), 6) != Z_OK) {
-    return "cannot compress the image for " + path;
-  }
+  if (compress2(packed.data(), &packed_size, raw.data(), static_cast<uLong>(raw.size()), 6) != Z_OK) return {};
   packed.resize(packed_size);
 
   std::vector<std::uint8_t> out{0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
@@ -131,7 +129,12 @@ std::string write_png(const std::string& path, const Image& image) {
   chunk(out, "IHDR", ihdr);
   chunk(out, "IDAT", packed);
   chunk(out, "IEND", {});
+  return out;
+}
 
+std::string write_png(const std::string& path, const Image& image) {
+  const std::vector<std::uint8_t> out = encode_png(image);
+  if (out.empty()) return "cannot compress the image for " + path;
   FILE* f = std::fopen(path.c_str(), "wb");
   if (f == nullptr) return "cannot write " + path;
   const bool ok = std::fwrite(out.data(), 1, out.size(), f) == out.size();

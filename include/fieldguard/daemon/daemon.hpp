@@ -10,6 +10,7 @@ namespace fieldguard::app {
 struct RunOptions {
   std::string config;                  // configuration file, read again on SIGHUP
   std::optional<std::string> can_log;  // a candump -L log instead of the configured CAN sink
+  std::optional<std::string> mcap_out;  // view.mcap.path instead of the configuration's (a bounded series of files)
   bool quiet = false;                  // no summary on exit
 };
 

@@ -44,6 +44,10 @@ class McapRecorder {
   bool frame(const LidarFrame& frame, const perception::FrameResult& result,
              std::span<const perception::LabeledPoint> points, const FusionInfo* fusion,
              const output::safety::Decision* decision);
+  // The same in two steps, for a caller that encodes the frame itself (and sends its messages elsewhere too):
+  // begin_frame() (a bounded recording may start its next file here), then each message of the frame.
+  bool begin_frame();
+  void message(Topic topic, std::int64_t stamp_ns, std::string_view json);
   // The summary and footer of the file being written.
   bool close();
 

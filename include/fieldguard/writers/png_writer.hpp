@@ -32,6 +32,8 @@ class Image {
   std::vector<std::uint8_t> pixels_;  // row-major RGB
 };
 
+// The PNG file's bytes; empty when zlib fails.
+[[nodiscard]] std::vector<std::uint8_t> encode_png(const Image& image);
 // Returns "" on success, else what went wrong.
 [[nodiscard]] std::string write_png(const std::string& path, const Image& image);
 
