@@ -91,10 +91,35 @@ void LiveView::frame(const DetectedFrame& d, const output::safety::Decision& dec
   wake_.release();
 }
 
-void LiveView::sensors(std::vector<ViewSensor> sensors, std::string status_line) {
-  const std::lock_guard lock(sensors_mutex_);
-  sensors_ = std::move(sensors);
-  status_line_ = std::move(status_line);
+void LiveView::status(const output::safety::Decision& decision, Stamp now, std::vector<ViewSensor> sensors,
+                      std::string status_line) {
+  {
+    const std::lock_guard lock(status_mutex_);
+    status_decision_ = decision;
+    status_stamp_ = now;
+    sensors_ = std::move(sensors);
+    status_line_ = std::move(status_line);
+    status_pending_ = true;
+  }
+  wake_.release();
+}
+
+void LiveView::show_status() {
+  {
+    const std::lock_guard lock(status_mutex_);
+    if (!status_pending_) return;
+    status_pending_ = false;
+    page_decision_ = status_decision_;
+    page_stamp_ = status_stamp_;
+  }
+  // On the timeline too: a recording and a viewer see the stop a silent sensor caused between frames.
+  foxglove::decision(message_, page_stamp_.ns, page_frame_, page_decision_, cfg_.safety.clear_frames, true);
+  last_decision_ns_ = std::max(page_stamp_.ns, last_decision_ns_);
+  const auto t = static_cast<std::uint64_t>(std::max<std::int64_t>(last_decision_ns_, 0));
+  if (mcap_ && !mcap_failed_) mcap_->message(Topic::Decision, last_decision_ns_, message_);
+  const auto ch = static_cast<std::size_t>(Topic::Decision);
+  if (server_ && server_->subscribed(ch)) server_->publish(ch, t, std::make_shared<const std::string>(message_));
+  if (server_) server_->set_page(page_json(), nullptr);
 }
 
 void LiveView::loop() {
@@ -107,6 +132,7 @@ void LiveView::loop() {
       show(slots_[i]);
       free_.push(i);
     }
+    show_status();
     if (stop_) return;
   }
 }
@@ -118,6 +144,9 @@ void LiveView::show(Slot& s) {
   const bool recording = mcap_ && !mcap_failed_ && mcap_->begin_frame();
   encoder_.encode(s.frame, result, s.labelled, fusion, &s.decision,
                   [&](Topic topic, std::int64_t t, std::string_view json) {
+                    // A decision taken on the clock may be later than the next frame's stamp (its first packet):
+                    // the channel's log times still never go back.
+                    if (topic == Topic::Decision) t = last_decision_ns_ = std::max(t, last_decision_ns_);
                     if (recording) mcap_->message(topic, t, json);
                     const auto ch = static_cast<std::size_t>(topic);
                     if (server_ && server_->subscribed(ch)) {
@@ -148,25 +177,30 @@ void LiveView::show(Slot& s) {
       png = std::make_shared<const std::vector<std::uint8_t>>(
           encode_png(render_bev(s.labelled, result, cfg_.perception, zone)));
     }
-    server_->set_page(status_json(s, result.obstacles.size()), std::move(png));
+    page_decision_ = s.decision;
+    page_frame_ = s.frame.index;
+    page_stamp_ = s.frame.host_stamp;
+    page_obstacles_ = result.obstacles.size();
+    server_->set_page(page_json(), std::move(png));
   }
   s.obstacles.swap(result.obstacles);
 }
 
-std::string LiveView::status_json(const Slot& s, std::size_t obstacles) {
+std::string LiveView::page_json() {
   nlohmann::json j;
-  j["stop"] = s.decision.stop;
-  j["headline"] = output::safety::headline(s.decision, cfg_.safety.clear_frames);
-  j["reason"] = output::safety::to_string(s.decision.reason);
-  j["frame"] = s.frame.index;
-  j["stamp"] = s.frame.host_stamp.seconds();
-  j["obstacles"] = obstacles;
+  j["stop"] = page_decision_.stop;
+  j["headline"] = output::safety::headline(page_decision_, cfg_.safety.clear_frames);
+  j["reason"] = output::safety::to_string(page_decision_.reason);
+  j["frame"] = page_frame_;
+  j["stamp"] = page_stamp_.seconds();
+  j["obstacles"] = page_obstacles_;
   {
-    const std::lock_guard lock(sensors_mutex_);
+    const std::lock_guard lock(status_mutex_);
     j["status"] = status_line_;
     j["sensors"] = nlohmann::json::array();
-    for (const ViewSensor& v : sensors_)
+    for (const ViewSensor& v : sensors_) {
       j["sensors"].push_back({{"name", v.name}, {"state", v.state}, {"rate_hz", v.rate_hz}});
+    }
   }
   j["view"] = {{"frames", frames_.load()}, {"dropped", dropped_.load()}};
   return j.dump();

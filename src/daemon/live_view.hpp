@@ -55,8 +55,10 @@ class LiveView {
 
   // A decided frame (its labelled points in d.labelled). Never waits.
   void frame(const DetectedFrame& d, const output::safety::Decision& decision);
-  // The sensors and the status line as the daemon reports them, for the page.
-  void sensors(std::vector<ViewSensor> sensors, std::string status_line);
+  // The decision as it stands between frames (a sensor gone silent stops the tractor with no frame to carry it),
+  // the sensors and the status line, for the page and the /safety/decision channel. Never waits.
+  void status(const output::safety::Decision& decision, Stamp now, std::vector<ViewSensor> sensors,
+              std::string status_line);
 
   [[nodiscard]] LiveViewCounts counts() const;
   [[nodiscard]] std::optional<std::uint16_t> port() const;
@@ -72,7 +74,8 @@ class LiveView {
   };
   void loop();
   void show(Slot& s);
-  [[nodiscard]] std::string status_json(const Slot& s, std::size_t obstacles);
+  void show_status();  // the status() handed over, on the view thread
+  [[nodiscard]] std::string page_json();
 
   const Config cfg_;
   std::vector<Slot> slots_;
@@ -89,8 +92,18 @@ class LiveView {
   std::atomic<bool> mcap_failed_{false};
   std::unique_ptr<ViewServer> server_;
   std::int64_t last_picture_ns_ = 0;
-  // Shared with the io thread.
-  mutable std::mutex sensors_mutex_;
+  // The page: the newest decision shown (a frame's or status()'s), its frame and time.
+  output::safety::Decision page_decision_;
+  std::uint64_t page_frame_ = 0;
+  Stamp page_stamp_;
+  std::size_t page_obstacles_ = 0;
+  std::string message_;                // scratch
+  std::int64_t last_decision_ns_ = 0;  // /safety/decision's newest log time
+  // Shared with the io thread (status()).
+  mutable std::mutex status_mutex_;
+  bool status_pending_ = false;
+  output::safety::Decision status_decision_;
+  Stamp status_stamp_;
   std::vector<ViewSensor> sensors_;
   std::string status_line_;
   std::atomic<std::uint64_t> mcap_frames_{0};

@@ -212,7 +212,10 @@ void Session::on_tick(std::chrono::nanoseconds late) {
   } else if (SteadyClock::now() - last_status_ >= kStatusEvery) {
     last_status_ = SteadyClock::now();
     notify_.status(status(now));
-    if (view_) view_->sensors(view_sensors(now), status(now));
+    if (view_ && stage_.last_decision()) {
+      view_->status(*stage_.last_decision(), now, view_sensors(now), status(now));
+      view_shown_ = std::pair(stage_.last_decision()->stop, stage_.last_decision()->reason);
+    }
     // With the status, and only between frames: the pool's slots a burst filled (frames released together after
     // a sensor outage) give their buffers back; a steady stream reuses no more than one per worker.
     trimmed_slots_ +=
@@ -224,6 +227,11 @@ void Session::on_tick(std::chrono::nanoseconds late) {
     trimmed_spares_ += fusion_.trim_spares();
   }
   if (!stalled && ready_) notify_.progress(SteadyClock::now());
+  // A change of the decision between frames (a sensor gone silent) reaches the view at once, not with the status.
+  if (const auto& d = stage_.last_decision(); view_ && d && view_shown_ != std::pair(d->stop, d->reason)) {
+    view_shown_ = std::pair(d->stop, d->reason);
+    view_->status(*d, now, view_sensors(now), status(now));
+  }
 }
 
 std::vector<ViewSensor> Session::view_sensors(Stamp now) const {
@@ -492,7 +500,10 @@ void Session::deliver(const Pool::Result& r) {
         static_cast<double>(latency_ns) * 1e-6, cfg_.realtime.latency_budget_ms);
   }
   // After the stop request is written, so that showing a frame is never part of deciding it.
-  if (view_ && stage_.last_decision()) view_->frame(*r.output, *stage_.last_decision());
+  if (view_ && stage_.last_decision()) {
+    view_->frame(*r.output, *stage_.last_decision());
+    view_shown_ = std::pair(stage_.last_decision()->stop, stage_.last_decision()->reason);
+  }
   if (ready_) notify_.progress(SteadyClock::now());
   if (!warm_frame_allocs_ && stage_.counts().frames >= kWarmFrames) {
     warm_frame_allocs_ = alloc::count(alloc::Path::Frame);

@@ -153,6 +153,7 @@ class Session {
   std::uint64_t trimmed_slots_ = 0;   // pool slots whose buffers went back (OrderedPool::trim_idle)
   std::uint64_t trimmed_spares_ = 0;  // spare buffers freed (SensorFusion::trim_spares)
   std::unique_ptr<LiveView> view_;    // view: the recording and the live server; made by start()
+  std::optional<std::pair<bool, output::safety::Reason>> view_shown_;  // the decision view_ last had from a tick
 };
 
 }  // namespace fieldguard::app

@@ -11,6 +11,7 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "daemon/view_page.hpp"
@@ -176,7 +177,9 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
       if (!j.contains("subscriptionIds") || !j["subscriptionIds"].is_array())
         return refuse("unsubscribe: no subscriptionIds");
       for (const Json& id : j["subscriptionIds"]) {
-        const auto it = id.is_number_unsigned() ? subs_.find(id.get<std::uint32_t>()) : subs_.end();
+        // Range-checked as subscribe checks it: 2^32 + 7 is not subscription 7.
+        const bool valid = id.is_number_unsigned() && id.get<std::uint64_t>() <= 0xFFFFFFFFU;
+        const auto it = valid ? subs_.find(static_cast<std::uint32_t>(id.get<std::uint64_t>())) : subs_.end();
         if (it == subs_.end()) {
           refuse("unsubscribe: no such subscription");
           continue;
@@ -200,30 +203,30 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     enqueue({{}, std::make_shared<const std::string>(status.dump()), true});
   }
 
-  // Bounded: when full, the oldest message not being written goes.
+  // Bounded: when full, the oldest waiting message goes. The one being written is not in the queue (in_flight_),
+  // so dropping never moves the memory an async_write is reading.
   void enqueue(Out o) {
     if (closed_) return;
     if (queue_.size() >= static_cast<std::size_t>(srv_.params.client_queue)) {
-      queue_.erase(queue_.begin() + (writing_ ? 1 : 0));
+      queue_.pop_front();
       ++srv_.n.dropped;
     }
     queue_.push_back(std::move(o));
-    if (!writing_) write_next();
+    if (!in_flight_) write_next();
   }
 
   void write_next() {
-    writing_ = true;
-    const Out& o = queue_.front();
-    ws_.text(o.text);
-    const std::array<net::const_buffer, 2> buffers{net::buffer(o.head), net::buffer(*o.body)};
+    in_flight_ = std::move(queue_.front());
+    queue_.pop_front();
+    ws_.text(in_flight_->text);
+    const std::array<net::const_buffer, 2> buffers{net::buffer(in_flight_->head), net::buffer(*in_flight_->body)};
     ws_.async_write(buffers, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->writing_ = false;
+      self->in_flight_.reset();
       if (ec) {
         self->gone();
         return;
       }
       ++self->srv_.n.sent;
-      if (!self->queue_.empty()) self->queue_.pop_front();
       if (!self->queue_.empty() && !self->closed_) self->write_next();
     });
   }
@@ -234,16 +237,16 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     --srv_.n.clients;
     for (const auto& [sub, ch] : subs_) --srv_.subscribers[ch];
     subs_.clear();
-    if (!writing_) queue_.clear();
+    queue_.clear();
   }
 
   ViewServer::Impl& srv_;
   websocket::stream<beast::tcp_stream> ws_;
   beast::flat_buffer in_;
-  std::deque<Out> queue_;
+  std::deque<Out> queue_;                      // waiting
+  std::optional<Out> in_flight_;               // being written
   std::map<std::uint32_t, std::size_t> subs_;  // subscription id -> channel index
   int bad_ = 0;
-  bool writing_ = false;
   bool closed_ = false;
 };
 

@@ -115,7 +115,7 @@ std::string decision_schema() {
               reasons + R"(,"reasons":)" + array_of(reasons) + R"(,"headline":)" + kString +
               R"(,"nearest_m":{"type":["number","null"]},"obstacles_in_zone":{"type":"integer","minimum":0},"zone":)" +
               zone,
-          R"("timestamp","frame","stop","reason","reasons","headline","nearest_m","obstacles_in_zone","zone")"));
+          R"("timestamp","frame","on","stop","reason","reasons","headline","nearest_m","obstacles_in_zone","zone")"));
 }
 
 struct SchemaTable {
@@ -422,13 +422,14 @@ void zones_scene(std::string& out, std::int64_t stamp_ns, const perception::Box3
 }
 
 void decision(std::string& out, std::int64_t stamp_ns, std::uint64_t frame, const output::safety::Decision& d,
-              int clear_frames) {
+              int clear_frames, bool on_clock) {
   namespace safety = output::safety;
   out.clear();
   out += R"({"timestamp":)";
   time(out, stamp_ns);
   out += R"(,"frame":)";
   integer(out, static_cast<std::int64_t>(frame));
+  out += on_clock ? R"(,"on":"clock")" : R"(,"on":"frame")";
   out += R"(,"stop":)";
   out += d.stop ? "true" : "false";
   out += R"(,"reason":)";

@@ -54,10 +54,11 @@ void obstacles_scene(std::string& out, std::int64_t stamp_ns, std::span<const pe
 // and the body box as outlines on the ground plane z = ground_z.
 void zones_scene(std::string& out, std::int64_t stamp_ns, const perception::Box3& roi, const perception::Box3& body,
                  double ground_z, const output::safety::Decision* decision);
-// fieldguard.Decision: {timestamp, frame, stop, reason, reasons, headline, nearest_m (null when none),
-// obstacles_in_zone, zone {x_min, x_max, half_width, speed_known}}.
+// fieldguard.Decision: {timestamp, frame, on, stop, reason, reasons, headline, nearest_m (null when none),
+// obstacles_in_zone, zone {x_min, x_max, half_width, speed_known}}. "on": "frame" for a frame's decision,
+// "clock" for one the daemon took between frames (a sensor gone silent; `frame` is then the last frame's).
 void decision(std::string& out, std::int64_t stamp_ns, std::uint64_t frame, const output::safety::Decision& d,
-              int clear_frames);
+              int clear_frames, bool on_clock = false);
 // foxglove.FrameTransform field -> lidar from a fused frame's detection pose, less `origin` (east, north, up).
 void frame_transform(std::string& out, std::int64_t stamp_ns, const perception::FramePose& pose,
                      const std::array<double, 3>& origin);
