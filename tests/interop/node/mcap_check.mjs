@@ -10,13 +10,9 @@
 // this reader decoded it, as one JSON line of OUT (in file order), for a test to compare with what it expects.
 import fs from "node:fs";
 import { McapIndexedReader, McapStreamReader } from "@mcap/core";
-import { NumericType } from "@foxglove/schemas";
-import * as foxgloveJsonSchemas from "@foxglove/schemas/jsonschema.js";
 import zstd from "@foxglove/wasm-zstd";
 import lz4 from "@foxglove/wasm-lz4";
-import Ajv from "ajv";
-import Ajv2019 from "ajv/dist/2019.js";
-import Ajv2020 from "ajv/dist/2020.js";
+import { makeChecker } from "./foxglove_validate.mjs";
 
 function usage(message) {
   process.stderr.write(`mcap_check: ${message}\nusage: node mcap_check.mjs FILE.mcap [--expect-topic TOPIC]... [--min-messages N] [--dump TOPIC OUT.jsonl]...\n`);
@@ -74,63 +70,8 @@ const sized = (name, fn) => (data, size) => {
 await Promise.all([zstd.isLoaded, lz4.isLoaded]);
 const decompressHandlers = { zstd: sized("zstd", zstd.decompress), lz4: sized("lz4", lz4) };
 
-// --- JSON schema validators, each schema compiled once -------------------------------------------------
-// Ajv treats contentEncoding as an annotation only; a bytes field that is not strict base64 (RFC 4648,
-// padded) would still be accepted by Node's lenient decoder but not by every viewer.
-function strictBase64(ajv) {
-  ajv.removeKeyword("contentEncoding");
-  ajv.addKeyword({
-    keyword: "contentEncoding",
-    schemaType: "string",
-    validate: function base64(enc, data) {
-      if (enc !== "base64" || typeof data !== "string" || (data.length % 4 === 0 && /^[A-Za-z0-9+/]*={0,2}$/.test(data))) return true;
-      base64.errors = [{ keyword: "contentEncoding", message: "must be standard padded base64 (RFC 4648)", params: {} }];
-      return false;
-    },
-  });
-  return ajv;
-}
-// The foxglove schemas declare no $schema, so Ajv's default draft-07; a file's own schema picks its draft.
-const ajvByDraft = new Map();
-function ajvFor(schema) {
-  const draft = schema.$schema ?? "http://json-schema.org/draft-07/schema#";
-  const key = /2020-12/.test(draft) ? "2020" : /2019-09/.test(draft) ? "2019" : /draft-0[67]/.test(draft) ? "07" : undefined;
-  if (!key) throw new Error(`unsupported $schema ${draft}`);
-  if (!ajvByDraft.has(key)) {
-    const Cls = { 2020: Ajv2020, 2019: Ajv2019, "07": Ajv }[key];
-    ajvByDraft.set(key, strictBase64(new Cls({ allErrors: false, addUsedSchema: false })));
-  }
-  return ajvByDraft.get(key);
-}
-function compile(schema, what) {
-  const validate = ajvFor(schema).compile(schema);
-  return (obj) => validate(obj) ? undefined : `${what}: ${ajvFor(schema).errorsText(validate.errors, { dataVar: "msg" })}`;
-}
-
-const TYPE_SIZE = { UINT8: 1, INT8: 1, UINT16: 2, INT16: 2, UINT32: 4, INT32: 4, FLOAT32: 4, FLOAT64: 8 };
-function checkPointCloud(msg) {
-  const stride = msg.point_stride;
-  if (!(stride > 0)) return ["point_stride must be > 0"];
-  const problems = [];
-  const bytes = Buffer.from(msg.data, "base64");
-  if (bytes.length % stride !== 0) problems.push(`data is ${bytes.length} bytes, not a multiple of point_stride ${stride}`);
-  for (const f of msg.fields) {
-    const size = TYPE_SIZE[NumericType[f.type]];
-    if (size === undefined) problems.push(`field ${f.name}: numeric type ${f.type} has no size`);
-    else if (f.offset + size > stride) problems.push(`field ${f.name}: offset ${f.offset} + ${size} > point_stride ${stride}`);
-  }
-  // Foxglove needs two coordinates to place a point.
-  if (msg.fields.filter((f) => ["x", "y", "z"].includes(f.name)).length < 2) problems.push("fewer than 2 of the fields x, y, z");
-  return problems;
-}
-
-// Compiled once per schema (the file's own by schema id, @foxglove/schemas' by name) and checked once per
-// channel: a channel's setup error is reported once, not per message.
-const compiled = new Map();
-function once(key, make) {
-  if (!compiled.has(key)) compiled.set(key, make());
-  return compiled.get(key);
-}
+// --- JSON schema validators (foxglove_validate.mjs), checked once per channel ---------------------------
+// A channel's setup error is reported once, not per message.
 const checkers = new Map();
 const utf8 = new TextDecoder("utf-8", { fatal: true });
 function checkerFor(channel, schema) {
@@ -140,19 +81,10 @@ function checkerFor(channel, schema) {
     if (channel.messageEncoding !== "json") throw new Error(`message encoding "${channel.messageEncoding}", expected "json"`);
     if (!schema) throw new Error(`schema id ${channel.schemaId} not found (schemaless channels are not expected)`);
     if (schema.encoding !== "jsonschema") throw new Error(`schema ${schema.name}: encoding "${schema.encoding}", expected "jsonschema"`);
-    const validators = [once(`own ${schema.id}`, () =>
-      compile(JSON.parse(utf8.decode(schema.data)), `schema ${schema.name} (embedded)`))];
-    if (schema.name.startsWith("foxglove.")) {
-      const upstream = foxgloveJsonSchemas[schema.name.slice("foxglove.".length)];
-      if (upstream?.title !== schema.name) throw new Error(`@foxglove/schemas has no JSON schema ${schema.name}`);
-      validators.unshift(once(`foxglove ${schema.name}`, () => compile(upstream, `schema ${schema.name} (@foxglove/schemas)`)));
-    }
-    const pointCloud = schema.name === "foxglove.PointCloud";
-    checker = (obj) => {
-      const problems = validators.map((v) => v(obj)).filter(Boolean);
-      if (pointCloud && problems.length === 0) problems.push(...checkPointCloud(obj));
-      return problems;
-    };
+    // The file's own schema is always checked too: an empty one is a setup error, not a skipped check.
+    const text = utf8.decode(schema.data);
+    if (text === "") throw new Error(`schema ${schema.name}: empty`);
+    checker = makeChecker(schema.name, text);
   } catch (e) {
     checker = { setupError: `channel ${channel.id} (${channel.topic}): ${e.message}` };
     fail(checker.setupError);
