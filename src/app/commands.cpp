@@ -125,6 +125,12 @@ Command add_replay(CLI::App& top) {
                   "(/safety/decision), and for a fused frame its pose (/tf) and position (/gnss/fix);\n"
                   "Foxglove's schemas, JSON-encoded (docs/commands.md)")
       ->type_name("FILE");
+  cmd->add_option("--geojson-out", opt->geojson_out,
+                  "run the detection pipeline and write the obstacles' footprints as GeoJSON: one Polygon\n"
+                  "(WGS84 longitude, latitude) per obstacle of each fused frame with a full pose (GNSS and\n"
+                  "AHRS), properties frame, stamp, distance_m, height_m, class, held; frames without a pose\n"
+                  "give none (counted in the summary)")
+      ->type_name("FILE");
   cmd->add_option("--mcap-compression", opt->mcap_compression, "the MCAP chunks' compression (default zstd)")
       ->check(CLI::IsMember({"zstd", "lz4", "none"}))
       ->type_name("zstd|lz4|none");
@@ -157,7 +163,8 @@ Command add_replay(CLI::App& top) {
   cmd->add_flag("--quiet", opt->quiet, "no progress line");
   return {cmd,
           "fieldguard replay --config FILE (--pcap FILE | --session DIR) [--obstacles-out FILE] [--mcap-out FILE]\n"
-          "                         [--bev-dir DIR] [--pcd-dir DIR] [--samples-out FILE] [--can-log FILE]\n"
+          "                         [--geojson-out FILE] [--bev-dir DIR] [--pcd-dir DIR] [--samples-out FILE] "
+          "[--can-log FILE]\n"
           "                         [--workers N] [--quiet]",
           [cmd, opt, workers] {
             if (const auto why = leftover(*cmd); !why.empty()) return usage_error(*cmd, why);

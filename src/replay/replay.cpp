@@ -37,6 +37,7 @@
 #include "fieldguard/sync/ordered_pool.hpp"
 #include "fieldguard/sync/synchronizer.hpp"
 #include "fieldguard/writers/bev.hpp"
+#include "fieldguard/writers/geojson.hpp"
 #include "fieldguard/writers/mcap_recorder.hpp"
 #include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "fieldguard/writers/pcd_writer.hpp"
@@ -210,6 +211,7 @@ class Replay {
   std::ofstream obstacles_out_;
   std::optional<output::CandumpLogSink> can_log_;
   std::optional<McapRecorder> mcap_;
+  std::optional<GeoJsonWriter> geojson_;
   // Without --can-log the obstacles JSONL still carries each frame's decision: the stage decides into a sink that
   // sends nowhere, from a configuration without the J1939 address claim (nothing is on a bus to contest it).
   output::NullSink no_bus_;
@@ -275,7 +277,8 @@ bool Replay::open() {
   if (!open_outputs()) return false;
   fusion_.emplace(cfg_, FusionInputs{recording_->has(LogKind::Scan2d), recording_->has(LogKind::Gnss),
                                      recording_->has(LogKind::Ahrs)});
-  detect_ = obstacles_out_.is_open() || !bev_dir_.empty() || can_.has_value() || mcap_.has_value();
+  detect_ =
+      obstacles_out_.is_open() || !bev_dir_.empty() || can_.has_value() || mcap_.has_value() || geojson_.has_value();
   // A fused frame needs the compensation even when only its points are written.
   if (detect_ || fusion_->fused()) detectors_.emplace(cfg_, workers_);
   sync::PoolParams pool_params;
@@ -315,6 +318,13 @@ bool Replay::open_outputs() {
     mcap_.emplace(cfg_);
     if (!mcap_->open(rec)) {
       std::fprintf(stderr, "fieldguard replay: %s\n", mcap_->error().c_str());
+      return false;
+    }
+  }
+  if (const auto& g = opt_.geojson_out) {
+    geojson_.emplace(cfg_.geo.projection, cfg_.lidar.mounting);
+    if (!geojson_->open(*g)) {
+      std::fprintf(stderr, "fieldguard replay: %s\n", geojson_->error().c_str());
       return false;
     }
   }
@@ -403,6 +413,7 @@ void Replay::write_frame(const Pool::Result& r) {
                    << '\n';
     if (!obstacles_out_) write_error_ = "cannot write " + *opt_.obstacles_out;
   }
+  if (geojson_ && write_error_.empty() && !geojson_->frame(f, result, fused)) write_error_ = geojson_->error();
   if (mcap_ && write_error_.empty()) {
     const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
     if (!mcap_->frame(f, result, r.output->det.labelled, fused, decision)) write_error_ = mcap_->error();
@@ -587,6 +598,16 @@ int Replay::finish() {
   }
   print_fusion_summary();
   if (samples_) samples_->finish();
+  if (geojson_) {
+    if (!geojson_->close() && write_error_.empty()) write_error_ = geojson_->error();
+    const GeoJsonCounts& g = geojson_->counts();
+    std::printf("  geojson           %llu footprints from %llu frames with a pose; %llu frames without one\n",
+                static_cast<unsigned long long>(g.features), static_cast<unsigned long long>(g.frames_placed),
+                static_cast<unsigned long long>(g.frames_unplaced));
+    if (g.frames_placed == 0) {
+      log_->warn("--geojson-out: no frame had a full pose (a session with GNSS and AHRS is needed): no footprints");
+    }
+  }
   if (mcap_) {
     if (!mcap_->close() && write_error_.empty()) write_error_ = mcap_->error();
     const McapRecorderStats m = mcap_->stats();

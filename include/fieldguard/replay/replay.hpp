@@ -16,6 +16,7 @@ struct ReplayOptions {
   std::optional<std::string> samples_out, obstacles_out, bev_dir, pcd_dir, can_log;
   std::optional<std::string> mcap_out;    // an MCAP recording of the frames (writers/mcap_recorder.hpp)
   std::string mcap_compression = "zstd";  // its chunks': zstd, lz4 or none
+  std::optional<std::string> geojson_out;  // the obstacles' footprints in WGS84 (writers/geojson.hpp)
   std::optional<std::size_t> workers;  // 1..64; pipeline.workers of the configuration when not given
   bool quiet = false;                  // no progress line
 };
