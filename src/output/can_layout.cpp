@@ -155,7 +155,9 @@ const std::array<MessageLayout, kMessageCount> kMessages{{
     {MessageId::ObstacleSummary, "FG_OBSTACLE_SUMMARY", kPgnSummary, 6, 8, 0,
      "What the pipeline found in one LiDAR rotation; sent once per frame before its FG_OBSTACLE messages", kSummary},
     {MessageId::Obstacle, "FG_OBSTACLE", kPgnObstacle, 6, 8, 0,
-     "One per obstacle, nearest first, up to the configured count; follows its frame's FG_OBSTACLE_SUMMARY", kObstacle},
+     "One per obstacle, nearest first, up to the configured count; follows its frame's FG_OBSTACLE_SUMMARY. In the "
+     "DBC its signals are multiplexed on Index (XMin_0 is the nearest obstacle's XMin)",
+     kObstacle, "Index"},
     {MessageId::StopRequest, "FG_STOP_REQUEST", kPgnStop, 3, 8, 100,
      "Stop request to the steering controller (Proprietary A, addressed). Sent cyclically; the controller must stop "
      "when it stops arriving, when AliveCounter repeats or jumps, or when Crc is wrong. Crc: CRC-8/SAE-J1850, poly "

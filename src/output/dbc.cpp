@@ -1,10 +1,13 @@
 #include "fieldguard/output/dbc.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cstdio>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace fieldguard::output {
 namespace {
@@ -31,6 +34,48 @@ std::string quoted(std::string_view s) {
   return "\"" + std::string(s) + "\"";
 }
 
+// The range the DBC declares: the signal's own, widened to every raw value its value table names (a "no obstacle"
+// 65535 beyond the distances the encoder sends), so that no tool reads a named value as out of range.
+std::pair<double, double> declared_range(const Signal& s) {
+  double lo = s.min;
+  double hi = s.max;
+  for (const ValueName& v : s.values) {
+    const double phys = static_cast<double>(v.raw) * s.scale + s.offset;
+    lo = std::min(lo, phys);
+    hi = std::max(hi, phys);
+  }
+  return {lo, hi};
+}
+
+std::string sg_line(const Signal& s, const std::string& name, const std::string& mux) {
+  const auto [lo, hi] = declared_range(s);
+  return " SG_ " + name + mux + " : " + std::to_string(s.start_bit) + "|" + std::to_string(s.length) + "@" +
+         (s.order == ByteOrder::Intel ? "1" : "0") + (s.is_signed ? "-" : "+") + " (" + num(s.scale) + "," +
+         num(s.offset) + ") [" + num(lo) + "|" + num(hi) + "] " + quoted(s.unit) + " " + std::string(kController) +
+         "\n";
+}
+
+bool multiplexed(const MessageLayout& m, const Signal& s) { return !m.multiplexor.empty() && s.name != m.multiplexor; }
+
+// Every value the multiplexor can take.
+unsigned mux_values(const MessageLayout& m) {
+  for (const Signal& s : m.signals) {
+    if (s.name == m.multiplexor) return 1U << s.length;
+  }
+  throw std::logic_error("dbc: multiplexor " + std::string(m.multiplexor) + " is not a signal of " +
+                         std::string(m.name));
+}
+
+std::string view_name(const Signal& s, unsigned v) { return std::string(s.name) + "_" + std::to_string(v); }
+
+// The names a signal has in the DBC: itself, or one per multiplexor value.
+std::vector<std::string> dbc_names(const MessageLayout& m, const Signal& s) {
+  if (!multiplexed(m, s)) return {std::string(s.name)};
+  std::vector<std::string> out;
+  for (unsigned v = 0; v < mux_values(m); ++v) out.push_back(view_name(s, v));
+  return out;
+}
+
 }  // namespace
 
 std::string dbc_text(const CanParams& params) {
@@ -47,10 +92,11 @@ std::string dbc_text(const CanParams& params) {
     o += "BO_ " + std::to_string(id) + " " + std::string(m.name) + ": " + std::to_string(m.dlc) + " " +
          std::string(kNode) + "\n";
     for (const Signal& s : m.signals) {
-      o += " SG_ " + std::string(s.name) + " : " + std::to_string(s.start_bit) + "|" + std::to_string(s.length) + "@" +
-           (s.order == ByteOrder::Intel ? "1" : "0") + (s.is_signed ? "-" : "+") + " (" + num(s.scale) + "," +
-           num(s.offset) + ") [" + num(s.min) + "|" + num(s.max) + "] " + quoted(s.unit) + " " +
-           std::string(kController) + "\n";
+      if (!multiplexed(m, s)) {
+        o += sg_line(s, std::string(s.name), s.name == m.multiplexor ? " M" : "");
+        continue;
+      }
+      for (unsigned v = 0; v < mux_values(m); ++v) o += sg_line(s, view_name(s, v), " m" + std::to_string(v));
     }
     o += "\n";
   }
@@ -71,7 +117,8 @@ std::string dbc_text(const CanParams& params) {
     const std::string id = std::to_string(dbc_ids[static_cast<std::size_t>(m.id)]);
     o += "CM_ BO_ " + id + " " + quoted(m.comment) + ";\n";
     for (const Signal& s : m.signals) {
-      if (!s.comment.empty()) o += "CM_ SG_ " + id + " " + std::string(s.name) + " " + quoted(s.comment) + ";\n";
+      if (s.comment.empty()) continue;
+      for (const std::string& n : dbc_names(m, s)) o += "CM_ SG_ " + id + " " + n + " " + quoted(s.comment) + ";\n";
     }
   }
 
@@ -92,9 +139,11 @@ std::string dbc_text(const CanParams& params) {
     const std::string id = std::to_string(dbc_ids[static_cast<std::size_t>(m.id)]);
     for (const Signal& s : m.signals) {
       if (s.values.empty()) continue;
-      o += "VAL_ " + id + " " + std::string(s.name);
-      for (const ValueName& v : s.values) o += " " + std::to_string(v.raw) + " " + quoted(v.name);
-      o += " ;\n";
+      for (const std::string& n : dbc_names(m, s)) {
+        o += "VAL_ " + id + " " + n;
+        for (const ValueName& v : s.values) o += " " + std::to_string(v.raw) + " " + quoted(v.name);
+        o += " ;\n";
+      }
     }
   }
   return o;

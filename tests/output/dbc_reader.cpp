@@ -9,9 +9,9 @@ namespace fieldguard::test::dbc {
 namespace {
 
 const std::regex kBo(R"re(^BO_\s+(\d+)\s+(\w+)\s*:\s*(\d+)\s+(\w+)\s*$)re");
-// SG_ name [mux] : start|len@order sign (factor,offset) [min|max] "unit" receivers
+// SG_ name [M | mN] : start|len@order sign (factor,offset) [min|max] "unit" receivers
 const std::regex kSg(
-    R"re(^\s*SG_\s+(\w+)\s*(?:\w+\s*)?:\s*(\d+)\|(\d+)@([01])([+-])\s*\(([^,]+),([^)]+)\)\s*\[([^|]+)\|([^\]]+)\]\s*"([^"]*)".*$)re");
+    R"re(^\s*SG_\s+(\w+)\s*(?:(M|m\d+)\s*)?:\s*(\d+)\|(\d+)@([01])([+-])\s*\(([^,]+),([^)]+)\)\s*\[([^|]+)\|([^\]]+)\]\s*"([^"]*)".*$)re");
 const std::regex kVal(R"re(^VAL_\s+(\d+)\s+(\w+)\s+(.*);\s*$)re");
 const std::regex kValPair(R"re((-?\d+)\s+"([^"]*)")re");
 const std::regex kCmBo(R"re(^CM_\s+BO_\s+(\d+)\s+"([^"]*)"\s*;\s*$)re");
@@ -82,15 +82,17 @@ Database parse(std::string_view text) {
       if (!std::regex_match(line, m, kSg)) fail("unreadable SG_");
       Signal s;
       s.name = m[1];
-      s.start_bit = to_u32(m[2]);
-      s.length = to_u32(m[3]);
-      s.little_endian = m[4] == "1";
-      s.is_signed = m[5] == "-";
-      s.factor = std::stod(m[6]);
-      s.offset = std::stod(m[7]);
-      s.min = std::stod(m[8]);
-      s.max = std::stod(m[9]);
-      s.unit = m[10];
+      s.multiplexor = m[2] == "M";
+      if (m[2].length() > 1) s.mux_value = to_u32(m[2].str().substr(1));
+      s.start_bit = to_u32(m[3]);
+      s.length = to_u32(m[4]);
+      s.little_endian = m[5] == "1";
+      s.is_signed = m[6] == "-";
+      s.factor = std::stod(m[7]);
+      s.offset = std::stod(m[8]);
+      s.min = std::stod(m[9]);
+      s.max = std::stod(m[10]);
+      s.unit = m[11];
       current->signals.push_back(s);
     } else if (line.rfind("VAL_ ", 0) == 0) {
       if (!std::regex_match(line, m, kVal)) fail("unreadable VAL_");
@@ -150,8 +152,15 @@ double physical_value(const Signal& s, std::span<const std::uint8_t> data) {
 }
 
 std::map<std::string, double> decode(const Message& m, std::span<const std::uint8_t> data) {
+  std::optional<std::uint64_t> mux;
+  for (const auto& s : m.signals) {
+    if (s.multiplexor) mux = raw_value(s, data);
+  }
   std::map<std::string, double> out;
-  for (const auto& s : m.signals) out[s.name] = physical_value(s, data);
+  for (const auto& s : m.signals) {
+    if (s.mux_value && (!mux || *s.mux_value != *mux)) continue;  // another multiplexor value's signal
+    out[s.name] = physical_value(s, data);
+  }
   return out;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // A small DBC reader for tests only. It shares no code with src/output (the layouts, the packer, the DBC
 // printer): decoding our frames through it is what shows that config/fieldguard.dbc and the encoder agree.
-// Reads BO_, SG_ (@1 Intel / @0 Motorola, + / -), CM_ BO_, BA_ "GenMsgCycleTime" and VAL_; ignores the rest.
+// Reads BO_, SG_ (@1 Intel / @0 Motorola, + / -, multiplexor M and multiplexed mN), CM_ BO_,
+// BA_ "GenMsgCycleTime" and VAL_; ignores the rest.
 
 #include <cstdint>
 #include <map>
@@ -25,6 +26,8 @@ struct Signal {
   double max = 0.0;
   std::string unit;
   std::map<std::int64_t, std::string> values;
+  bool multiplexor = false;           // M
+  std::optional<unsigned> mux_value;  // mN: present only when the multiplexor's raw value is N
 };
 
 struct Message {
@@ -53,7 +56,7 @@ struct Database {
 
 [[nodiscard]] std::uint64_t raw_value(const Signal& s, std::span<const std::uint8_t> data);
 [[nodiscard]] double physical_value(const Signal& s, std::span<const std::uint8_t> data);
-// Every signal of `m` in `data`, physical values by name.
+// Every signal of `m` in `data`, physical values by name (of multiplexed signals, those of the multiplexor's value).
 [[nodiscard]] std::map<std::string, double> decode(const Message& m, std::span<const std::uint8_t> data);
 
 }  // namespace fieldguard::test::dbc

@@ -48,8 +48,23 @@ TEST(Dbc, DescribesEveryMessageWithExtendedIdsAndItsConventions) {
     EXPECT_TRUE(dm.extended());
     EXPECT_EQ(dm.dbc_id, enc.id_of(m.id) | 0x80000000U);
     EXPECT_EQ(dm.dlc, 8U);
-    EXPECT_EQ(dm.signals.size(), m.signals.size());
+    // A multiplexed message has its multiplexor and every other signal once per multiplexor value (16 for a 4-bit
+    // Index); each of them in the DBC is multiplexed.
+    const std::size_t per = m.multiplexor.empty() ? 1 : 16;
+    EXPECT_EQ(dm.signals.size(), m.multiplexor.empty() ? m.signals.size() : 1 + (m.signals.size() - 1) * per);
+    for (const dbc::Signal& s : dm.signals) {
+      EXPECT_EQ(s.multiplexor, !m.multiplexor.empty() && s.name == m.multiplexor) << s.name;
+      EXPECT_EQ(s.mux_value.has_value(), !m.multiplexor.empty() && s.name != m.multiplexor) << s.name;
+    }
     EXPECT_FALSE(dm.comment.empty());
+  }
+  const dbc::Message& obstacle = db.by_name("FG_OBSTACLE");
+  EXPECT_EQ(obstacle.signal("XMin_15").mux_value, 15U);
+  EXPECT_EQ(obstacle.signal("SizeClass_3").values.at(1), "LARGE");
+  // A value the table names is inside the declared range: NO_OBSTACLE (raw 65535) is 655.35 m and 475.35 deg.
+  for (const char* name : {"NearestDistance", "NearestBearing"}) {
+    const dbc::Signal& s = db.by_name("FG_OBSTACLE_SUMMARY").signal(name);
+    EXPECT_LE(65535.0 * s.factor + s.offset, s.max + 1e-9) << name;
   }
   const dbc::Message& stop = db.by_name("FG_STOP_REQUEST");
   EXPECT_NE(stop.comment.find("CRC-8/SAE-J1850"), std::string::npos);
@@ -131,18 +146,21 @@ TEST_F(DbcRoundTrip, ObstacleFramesDecodeToTheirValues) {
       SCOPED_TRACE("frame " + std::to_string(frame) + " obstacle " + std::to_string(i - 1));
       EXPECT_EQ(message_of(out[i]).name, "FG_OBSTACLE");
       EXPECT_EQ(d.at("Index"), static_cast<double>(i - 1));
-      EXPECT_EQ(d.at("SizeClass"), static_cast<double>(o.size_class));
+      EXPECT_EQ(d.at("SizeClass_" + std::to_string(i - 1)), static_cast<double>(o.size_class));
+      // Multiplexed on Index in the DBC: the nearest obstacle's XMin is XMin_0, and only its own are decoded.
+      const std::string suffix = "_" + std::to_string(i - 1);
+      EXPECT_EQ(d.count("XMin_" + std::to_string(i)), 0U);
       const auto check = [&](const char* name, float v, double lo, double hi, double step) {
         const double want = clamp_step(static_cast<double>(v), lo, hi);
         any_clamped |= want != static_cast<double>(v) && std::abs(want - static_cast<double>(v)) > step / 2;
-        EXPECT_NEAR(d.at(name), want, step / 2 + 1e-6) << name;
+        EXPECT_NEAR(d.at(name + suffix), want, step / 2 + 1e-6) << name;
       };
       check("XMin", o.min[0], -102.4, 102.3, 0.1);
       check("XMax", o.max[0], -102.4, 102.3, 0.1);
       check("YMin", o.min[1], -102.4, 102.3, 0.1);
       check("YMax", o.max[1], -102.4, 102.3, 0.1);
       check("Height", o.height_above_ground_m, 0, 12.6, 0.2);
-      EXPECT_EQ(d.at("Points"), std::min(255.0, static_cast<double>(o.points)));
+      EXPECT_EQ(d.at("Points_" + std::to_string(i - 1)), std::min(255.0, static_cast<double>(o.points)));
       any_clamped |= o.points > 255;
     }
     if (!obs.empty() && any_clamped) {

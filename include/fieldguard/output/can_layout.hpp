@@ -52,6 +52,9 @@ struct MessageLayout {
   std::uint32_t cycle_ms;  // 0 = once per pipeline frame, not on a timer
   std::string_view comment;
   std::span<const Signal> signals;
+  // The DBC's view only (dbc.cpp), the frame is the same: the signal every other signal is multiplexed on, so that
+  // a tool's signal view shows each of its values apart (FG_OBSTACLE: Index, XMin_0 ... XMin_15). "" = none.
+  std::string_view multiplexor = {};
 };
 
 [[nodiscard]] std::span<const MessageLayout> message_layouts();
