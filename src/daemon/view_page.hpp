@@ -19,7 +19,7 @@ inline constexpr const char* kStatusPage = R"html(<!doctype html>
   #decision.go { background: #2e7d32; color: #fff; }
   #decision.unknown { background: #555; color: #fff; }
   #reason { font-size: 4vw; font-weight: normal; margin-top: 1vh; }
-  main { display: flex; flex-wrap: wrap; gap: 2vw; padding: 2vw; }
+  main { display: flex; flex-wrap: wrap; gap: 2vw; padding: 2vw; align-items: flex-start; }
   table { border-collapse: collapse; font-size: 2.6vh; }
   td, th { padding: 0.6vh 1.2vw; text-align: left; border-bottom: 1px solid #333; }
   .ok { color: #81c784; } .fault { color: #ff8a80; font-weight: bold; } .off { color: #888; }
