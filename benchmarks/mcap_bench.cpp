@@ -4,6 +4,7 @@
 //   BM_EncodeFrame         FrameEncoder: the frame's Foxglove JSON messages (base64 point bytes), no file
 //   BM_RecordFrame/zstd..  the same through McapRecorder into a file: encoding, chunking, compression, the write
 //   BM_CopyIntoViewSlot    what the io thread does for the view: copy the frame into a slot (LiveView::frame)
+//   BM_DrawPicture         the bird's-eye picture with cairo (replay --bev-dir, the status page), and its PNG
 // The live daemon does all but the last on the view's own thread: these figures say how much of a core the view
 // needs (a 10 Hz LiDAR gives it 100 ms a frame), and the copy what the io thread pays.
 
@@ -16,6 +17,7 @@
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/perception/pipeline.hpp"
+#include "fieldguard/writers/bev.hpp"
 #include "fieldguard/writers/frame_messages.hpp"
 #include "fieldguard/writers/mcap_recorder.hpp"
 #include "sim_frames.hpp"
@@ -128,6 +130,20 @@ void BM_CopyIntoViewSlot(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_CopyIntoViewSlot)->Unit(benchmark::kMicrosecond);
+
+void BM_DrawPicture(benchmark::State& state) {
+  const Frame& f = frame();
+  const perception::Box3 zone{{0.4, -2.0, -10.0}, {17.4, 2.0, 10.0}};
+  const app::BevCaption caption{f.frame.index, f.frame.host_stamp, false, &f.decision, 3};
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    const app::Picture p = app::render_bev(f.labelled, f.result.obstacles, f.cfg.perception, zone, caption);
+    if (state.range(0) != 0) bytes = p.png().size();
+    benchmark::DoNotOptimize(p.width());
+  }
+  state.counters["png_bytes"] = static_cast<double>(bytes);
+}
+BENCHMARK(BM_DrawPicture)->Arg(0)->Arg(1)->ArgName("png")->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -8,7 +8,6 @@
 #include "fieldguard/sync/threads.hpp"
 #include "fieldguard/writers/bev.hpp"
 #include "fieldguard/writers/foxglove_json.hpp"
-#include "fieldguard/writers/png_writer.hpp"
 
 namespace fieldguard::app {
 namespace {
@@ -174,8 +173,10 @@ void LiveView::show(Slot& s) {
       last_picture_ns_ = now;
       const auto& z = s.decision.zone;
       const perception::Box3 zone{{z.x_min_m, -z.half_width_m, -10.0}, {z.x_max_m, z.half_width_m, 10.0}};
+      const BevCaption caption{s.frame.index, s.frame.host_stamp, s.frame.partial, &s.decision,
+                               cfg_.safety.clear_frames};
       png = std::make_shared<const std::vector<std::uint8_t>>(
-          encode_png(render_bev(s.labelled, result, cfg_.perception, zone)));
+          render_bev(s.labelled, result.obstacles, cfg_.perception, zone, caption).png());
     }
     page_decision_ = s.decision;
     page_frame_ = s.frame.index;

@@ -41,7 +41,6 @@
 #include "fieldguard/writers/mcap_recorder.hpp"
 #include "fieldguard/writers/obstacles_jsonl.hpp"
 #include "fieldguard/writers/pcd_writer.hpp"
-#include "fieldguard/writers/png_writer.hpp"
 #include "replay/recording.hpp"
 
 namespace fieldguard::app {
@@ -149,7 +148,6 @@ class HeardTimes {
 // A frame on its way through the worker pool: see fusion.hpp.
 struct Processed {
   DetectedFrame det;
-  std::optional<Image> bev;  // rendered by the worker: it needs that worker's Pipeline::last_points()
 };
 
 using Pool = sync::OrderedPool<FrameJob, Processed>;
@@ -222,9 +220,8 @@ class Replay {
   std::optional<DetectorSet> detectors_;
   std::optional<Pool> pool_;
   std::vector<FrameJob> jobs_;
-  perception::ObstacleHold hold_;           // frame to frame, so here in frame order and not in the workers
-  std::vector<perception::Obstacle> held_;  // one frame's held obstacles, for its picture
-  std::array<HeardTimes, 3> heard_;         // scan2d, gnss, ahrs: LogKind order
+  perception::ObstacleHold hold_;    // frame to frame, so here in frame order and not in the workers
+  std::array<HeardTimes, 3> heard_;  // scan2d, gnss, ahrs: LogKind order
   std::deque<TimedProblem> problems_;
   // Counts for the summary.
   PositionCounters pos_;
@@ -336,7 +333,7 @@ bool Replay::open_outputs() {
       std::fprintf(stderr, "fieldguard replay: --can-log: %s\n", e.what());
       return false;
     }
-  } else if (obstacles_out_.is_open() || mcap_) {
+  } else if (obstacles_out_.is_open() || mcap_ || !bev_dir_.empty()) {
     decide_cfg_ = cfg_;
     decide_cfg_->can.j1939.address_claim = false;
     can_.emplace(*decide_cfg_, no_bus_);
@@ -344,11 +341,10 @@ bool Replay::open_outputs() {
   return true;
 }
 
-// On a worker: compensation, perception, and the bird's-eye picture (it needs that worker's pipeline).
+// On a worker: compensation and perception, the labelled points kept with the frame when an output draws them.
 // Everything that is written happens in deliver(), on the reading thread, in frame order: the output does not
 // depend on the number of workers.
 void Replay::process(FrameJob& job, Processed& out) {
-  out.bev.reset();
   if (!detectors_) {
     std::swap(out.det.frame, job.rotation);
     out.det.result = perception::FrameResult{};
@@ -356,10 +352,8 @@ void Replay::process(FrameJob& job, Processed& out) {
     return;
   }
   const DetectorSet::Lease detector(*detectors_);
-  detector->process(job, out.det, detect_, mcap_.has_value());
-  if (!bev_dir_.empty()) {
-    out.bev = render_bev(detector->pipeline().last_points(), out.det.result, cfg_.perception, std::nullopt);
-  }
+  // The labelled points stay with the frame for the outputs drawn after its decision (MCAP, the picture).
+  detector->process(job, out.det, detect_, mcap_.has_value() || !bev_dir_.empty());
 }
 
 void Replay::deliver(const Pool::Result& r) {
@@ -377,8 +371,8 @@ void Replay::deliver(const Pool::Result& r) {
   write_frame(r);
 }
 
-// One processed frame's outputs, in frame order: its PCD, then (when detecting) the hold, the obstacles line,
-// the picture and the CAN stage's decision.
+// One processed frame's outputs, in frame order: its PCD, then (when detecting) the hold, the CAN stage's
+// decision, the obstacles line, GeoJSON, MCAP and the picture (with the decision and its stop zone).
 void Replay::write_frame(const Pool::Result& r) {
   const LidarFrame& f = r.output->det.frame;
   const FusionInfo* fused = r.output->det.fusion ? &*r.output->det.fusion : nullptr;
@@ -396,13 +390,6 @@ void Replay::write_frame(const Pool::Result& r) {
       fused != nullptr ? detection_pose(*fused, cfg_.lidar.mounting) : std::nullopt;
   hold_.apply(f.host_stamp.ns, result, std::nullopt, pose);
   held_total_ += result.counts.held;
-  if (result.counts.held > 0 && r.output->bev) {
-    held_.clear();
-    for (const auto& o : result.obstacles) {
-      if (o.held) held_.push_back(o);
-    }
-    draw_obstacles(*r.output->bev, held_);
-  }
   obstacles_total_ += result.obstacles.size();
   times_.push_back(result.times);
   // Decided before the obstacles line is written: the line carries the decision.
@@ -418,8 +405,16 @@ void Replay::write_frame(const Pool::Result& r) {
     const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
     if (!mcap_->frame(f, result, r.output->det.labelled, fused, decision)) write_error_ = mcap_->error();
   }
-  if (r.output->bev && write_error_.empty()) {
-    write_error_ = write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string(), *r.output->bev);
+  if (!bev_dir_.empty() && write_error_.empty()) {
+    const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
+    std::optional<perception::Box3> zone;
+    if (decision != nullptr) {
+      zone = perception::Box3{{decision->zone.x_min_m, -decision->zone.half_width_m, -10.0},
+                              {decision->zone.x_max_m, decision->zone.half_width_m, 10.0}};
+    }
+    const BevCaption caption{f.index, f.host_stamp, f.partial, decision, cfg_.safety.clear_frames};
+    write_error_ = render_bev(r.output->det.labelled, result.obstacles, cfg_.perception, zone, caption)
+                       .write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string());
   }
 }
 
