@@ -118,7 +118,11 @@ std::string dbc_text(const CanParams& params) {
     o += "CM_ BO_ " + id + " " + quoted(m.comment) + ";\n";
     for (const Signal& s : m.signals) {
       if (s.comment.empty()) continue;
-      for (const std::string& n : dbc_names(m, s)) o += "CM_ SG_ " + id + " " + n + " " + quoted(s.comment) + ";\n";
+      for (const std::string& n : dbc_names(m, s)) {
+        o += "CM_ SG_ ";
+        o += id;
+        o += " " + n + " " + quoted(s.comment) + ";\n";
+      }
     }
   }
 
@@ -140,7 +144,9 @@ std::string dbc_text(const CanParams& params) {
     for (const Signal& s : m.signals) {
       if (s.values.empty()) continue;
       for (const std::string& n : dbc_names(m, s)) {
-        o += "VAL_ " + id + " " + n;
+        o += "VAL_ ";
+        o += id;
+        o += " " + n;
         for (const ValueName& v : s.values) o += " " + std::to_string(v.raw) + " " + quoted(v.name);
         o += " ;\n";
       }

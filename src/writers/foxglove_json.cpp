@@ -375,12 +375,14 @@ void obstacles_scene(std::string& out, std::int64_t stamp_ns, std::span<const pe
   for (std::size_t i = 0; i < obstacles.size(); ++i) {
     const perception::Obstacle& o = obstacles[i];
     if (i != 0) out += ',';
-    const double z0 = o.min[2];
+    const auto z0 = static_cast<double>(o.min[2]);
     const double h = std::max(0.05, static_cast<double>(o.max[2]) - z0);
     out += R"({"pose":)";
-    yaw_pose(out, o.obb_center[0], o.obb_center[1], z0 + h / 2, o.obb_yaw_rad);
+    yaw_pose(out, static_cast<double>(o.obb_center[0]), static_cast<double>(o.obb_center[1]), z0 + h / 2,
+             static_cast<double>(o.obb_yaw_rad));
     out += R"(,"size":)";
-    vec3(out, std::max(0.05F, o.obb_length_m), std::max(0.05F, o.obb_width_m), h);
+    vec3(out, std::max(0.05, static_cast<double>(o.obb_length_m)), std::max(0.05, static_cast<double>(o.obb_width_m)),
+         h);
     out += R"(,"color":)";
     color(out, o.held ? kBlueBox : (zone != nullptr && output::safety::overlaps(o, *zone)) ? kRedBox : kOrange);
     out += '}';
@@ -392,7 +394,8 @@ void obstacles_scene(std::string& out, std::int64_t stamp_ns, std::span<const pe
     char label[64];
     std::snprintf(label, sizeof label, "%.1f m%s, %.1f m high", static_cast<double>(o.distance_m),
                   o.held ? " (held)" : "", static_cast<double>(o.height_above_ground_m));
-    text(out, o.obb_center[0], o.obb_center[1], static_cast<double>(o.max[2]) + 0.3, 12.0, kWhite, label);
+    text(out, static_cast<double>(o.obb_center[0]), static_cast<double>(o.obb_center[1]),
+         static_cast<double>(o.max[2]) + 0.3, 12.0, kWhite, label);
   }
   out += "]}]}";
 }

@@ -17,7 +17,7 @@
 #include "fieldguard/perception/obstacle.hpp"
 #include "fieldguard/perception/params.hpp"
 
-struct _cairo_surface;
+struct _cairo_surface;  // NOLINT(bugprone-reserved-identifier,cert-dcl37-c,cert-dcl51-cpp): cairo's own name
 
 namespace fieldguard::app {
 
