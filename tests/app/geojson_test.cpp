@@ -34,12 +34,10 @@ std::pair<double, double> local_m(const Json& p, const Json& origin) {
 }
 
 TEST(GeoJson, FusedSessionFootprintsAreTheObstacleBoxesOnTheEarth) {
-  testing::TempDir dir;
-  const std::string session = (dir.path() / "s").string();
-  ASSERT_EQ(std::system(("'" + std::string(FIELDGUARD_SIM) +
-                         "' --scene uneven-drive --rotations 20 --quiet --session '" + session + "'")
-                            .c_str()),
-            0);
+  const testing::FusedSession fused(20);
+  ASSERT_TRUE(fused.ok) << fused.command;
+  const testing::TempDir& dir = fused.dir;
+  const std::string& session = fused.path;
   const std::string geojson = (dir.path() / "o.geojson").string();
   const std::string jsonl = (dir.path() / "o.jsonl").string();
   const auto r = run_fieldguard("replay --quiet --config '" + std::string(FIELDGUARD_TEST_DATA) +

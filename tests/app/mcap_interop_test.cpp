@@ -119,12 +119,10 @@ TEST(McapInterop, PedestrianStopAndGoAreInTheRecording) {
 }
 
 TEST(McapInterop, FusedSessionHasItsPoseAndPosition) {
-  testing::TempDir dir;
-  const std::string session = (dir.path() / "s").string();
-  ASSERT_EQ(std::system(("'" + std::string(FIELDGUARD_SIM) +
-                         "' --scene uneven-drive --rotations 20 --quiet --session '" + session + "'")
-                            .c_str()),
-            0);
+  const testing::FusedSession fused(20);
+  ASSERT_TRUE(fused.ok) << fused.command;
+  const testing::TempDir& dir = fused.dir;
+  const std::string& session = fused.path;
   const std::string mcap = (dir.path() / "f.mcap").string();
   const auto r = run_fieldguard("replay --quiet --config '" + std::string(FIELDGUARD_TEST_DATA) +
                                 "/fusion/uneven-drive.yaml' --session '" + session + "' --mcap-out '" + mcap +

@@ -101,12 +101,10 @@ TEST(ObstaclesSchema, PedestrianInTheZoneStopsAndTheLinesSaySo) {
 }
 
 TEST(ObstaclesSchema, FusedSessionLinesAreValid) {
-  testing::TempDir dir;
-  const std::string session = (dir.path() / "s").string();
-  ASSERT_EQ(std::system(("'" + std::string(FIELDGUARD_SIM) +
-                         "' --scene uneven-drive --rotations 30 --quiet --session '" + session + "'")
-                            .c_str()),
-            0);
+  const testing::FusedSession fused(30);
+  ASSERT_TRUE(fused.ok) << fused.command;
+  const testing::TempDir& dir = fused.dir;
+  const std::string& session = fused.path;
   const std::string out = (dir.path() / "o.jsonl").string();
   const auto r = run_fieldguard("replay --quiet --config '" + std::string(FIELDGUARD_TEST_DATA) +
                                 "/fusion/uneven-drive.yaml' --session '" + session + "' --obstacles-out '" + out + "'");

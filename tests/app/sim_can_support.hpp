@@ -47,6 +47,20 @@ struct PedestrianCapture {
   bool ok = false;
 };
 
+// A recorded session of the simulator's uneven drive (every sensor: lidar.pcap and the byte logs), in a temporary
+// directory: what a fused replay reads.
+struct FusedSession {
+  explicit FusedSession(int rotations) : path((dir.path() / "s").string()) {
+    command = std::string("'") + FIELDGUARD_SIM + "' --scene uneven-drive --rotations " + std::to_string(rotations) +
+              " --quiet --session '" + path + "'";
+    ok = std::system(command.c_str()) == 0;
+  }
+  TempDir dir;
+  std::string path;
+  std::string command;
+  bool ok = false;
+};
+
 struct LogFrame {
   long long us = 0;  // stamp, microseconds
   std::string iface;
