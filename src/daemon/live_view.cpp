@@ -104,12 +104,14 @@ void LiveView::status(const output::safety::Decision& decision, Stamp now, std::
 }
 
 void LiveView::show_status() {
+  std::string health;
   {
     const std::lock_guard lock(status_mutex_);
     if (!status_pending_) return;
     status_pending_ = false;
     page_decision_ = status_decision_;
     page_stamp_ = status_stamp_;
+    foxglove::health(health, page_stamp_.ns, sensors_, status_line_);
   }
   // On the timeline too: a recording and a viewer see the stop a silent sensor caused between frames.
   foxglove::decision(message_, page_stamp_.ns, page_frame_, page_decision_, cfg_.safety.clear_frames, true);
@@ -118,6 +120,13 @@ void LiveView::show_status() {
   if (mcap_ && !mcap_failed_) mcap_->message(Topic::Decision, last_decision_ns_, message_);
   const auto ch = static_cast<std::size_t>(Topic::Decision);
   if (server_ && server_->subscribed(ch)) server_->publish(ch, t, std::make_shared<const std::string>(message_));
+  // The sensors too, on their own channel.
+  const auto h = static_cast<std::size_t>(Topic::Health);
+  if (mcap_ && !mcap_failed_) mcap_->message(Topic::Health, page_stamp_.ns, health);
+  if (server_ && server_->subscribed(h)) {
+    server_->publish(h, static_cast<std::uint64_t>(std::max<std::int64_t>(page_stamp_.ns, 0)),
+                     std::make_shared<const std::string>(std::move(health)));
+  }
   if (server_) server_->set_page(page_json(), nullptr);
 }
 

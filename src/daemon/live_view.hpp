@@ -21,17 +21,14 @@
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/engine/fusion.hpp"
 #include "fieldguard/output/safety_monitor.hpp"
+#include "fieldguard/writers/foxglove_json.hpp"
 #include "fieldguard/writers/frame_messages.hpp"
 #include "fieldguard/writers/mcap_recorder.hpp"
 
 namespace fieldguard::app {
 
-// One sensor as the status page lists it.
-struct ViewSensor {
-  std::string name;
-  std::string state;  // "ok", "silent 1.4 s", "never heard", "off"
-  double rate_hz = 0.0;
-};
+// One sensor as the status page and the /health channel list it.
+using ViewSensor = foxglove::SensorState;
 
 struct LiveViewCounts {
   std::uint64_t frames = 0;   // handed to the view

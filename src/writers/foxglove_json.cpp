@@ -118,12 +118,21 @@ std::string decision_schema() {
           R"("timestamp","frame","on","stop","reason","reasons","headline","nearest_m","obstacles_in_zone","zone")"));
 }
 
+std::string health_schema() {
+  const std::string sensor =
+      object(R"("name":{"type":"string"},"state":{"type":"string"},"rate_hz":{"type":"number","minimum":0})",
+             R"("name","state","rate_hz")");
+  return with_title("fieldguard.Health",
+                    object(R"("timestamp":)" + kTime + R"(,"sensors":)" + array_of(sensor) + R"(,"status":)" + kString,
+                           R"("timestamp","sensors","status")"));
+}
+
 struct SchemaTable {
-  std::array<std::string, 5> texts{point_cloud_schema(), scene_update_schema(), frame_transform_schema(),
-                                   location_fix_schema(), decision_schema()};
-  std::array<Schema, 5> schemas{Schema{"foxglove.PointCloud", texts[0]}, Schema{"foxglove.SceneUpdate", texts[1]},
+  std::array<std::string, 6> texts{point_cloud_schema(),  scene_update_schema(), frame_transform_schema(),
+                                   location_fix_schema(), decision_schema(),     health_schema()};
+  std::array<Schema, 6> schemas{Schema{"foxglove.PointCloud", texts[0]},     Schema{"foxglove.SceneUpdate", texts[1]},
                                 Schema{"foxglove.FrameTransform", texts[2]}, Schema{"foxglove.LocationFix", texts[3]},
-                                Schema{"fieldguard.Decision", texts[4]}};
+                                Schema{"fieldguard.Decision", texts[4]},     Schema{"fieldguard.Health", texts[5]}};
 };
 const SchemaTable& table() {
   static const SchemaTable t;
@@ -482,6 +491,26 @@ void frame_transform(std::string& out, std::int64_t stamp_ns, const perception::
   out += R"(,"w":)";
   num(out, std::cos(pose.yaw_rad / 2), 6);
   out += "}}";
+}
+
+void health(std::string& out, std::int64_t stamp_ns, std::span<const SensorState> sensors, std::string_view status) {
+  out.clear();
+  out += R"({"timestamp":)";
+  time(out, stamp_ns);
+  out += R"(,"sensors":[)";
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    if (i != 0) out += ',';
+    out += R"({"name":)";
+    str(out, sensors[i].name);
+    out += R"(,"state":)";
+    str(out, sensors[i].state);
+    out += R"(,"rate_hz":)";
+    num(out, std::max(0.0, sensors[i].rate_hz), 1);
+    out += '}';
+  }
+  out += R"(],"status":)";
+  str(out, status);
+  out += '}';
 }
 
 void location_fix(std::string& out, std::int64_t stamp_ns, const geo::Geodetic& g) {

@@ -68,7 +68,7 @@ TEST(FoxgloveJson, Base64MatchesRfc4648) {
 }
 
 TEST(FoxgloveJson, EverySchemaIsJsonNamingItsTitle) {
-  ASSERT_EQ(foxglove::schemas().size(), 5U);
+  ASSERT_EQ(foxglove::schemas().size(), 6U);
   for (const auto& s : foxglove::schemas()) {
     const Json j = Json::parse(s.json);
     EXPECT_EQ(j.at("title"), s.name);
@@ -244,6 +244,20 @@ TEST(FoxgloveJson, FrameTransformIsThePoseLessTheOrigin) {
   EXPECT_NEAR(j.at("translation").at("y").get<double>(), 20.25, 1e-9);
   EXPECT_NEAR(j.at("rotation").at("z").get<double>(), std::sqrt(0.5), 1e-6);
   EXPECT_NEAR(j.at("rotation").at("w").get<double>(), std::sqrt(0.5), 1e-6);
+}
+
+TEST(FoxgloveJson, HealthListsEverySensorWithTheStatusLine) {
+  const std::vector<foxglove::SensorState> sensors = {
+      {"lidar", "ok", 10.0}, {"gnss", "silent 1.4 s", 0.0}, {"ahrs", "off", 0.0}};
+  std::string msg;
+  foxglove::health(msg, 3'000'000'001, sensors, "STOP gnss silent | gnss silent 1.4 s");
+  const Json j = Json::parse(msg);
+  EXPECT_EQ(j.at("timestamp").at("sec"), 3);
+  EXPECT_EQ(j.at("timestamp").at("nsec"), 1);
+  ASSERT_EQ(j.at("sensors").size(), 3U);
+  EXPECT_EQ(j.at("sensors")[1].at("state"), "silent 1.4 s");
+  EXPECT_NEAR(j.at("sensors")[0].at("rate_hz").get<double>(), 10.0, 1e-9);
+  EXPECT_EQ(j.at("status"), "STOP gnss silent | gnss silent 1.4 s");
 }
 
 TEST(FoxgloveJson, LocationFixInDegrees) {

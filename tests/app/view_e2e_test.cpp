@@ -173,8 +173,8 @@ TEST_F(ViewE2e, FoxgloveClientGetsEveryChannelValidAndTheRecordedDecisions) {
   ASSERT_EQ(client.exit_code, 0) << "@foxglove/ws-protocol (tools/install-deps installs it): " << client.output;
   const Json s = Json::parse(client.output.substr(client.output.find('{')));
   EXPECT_EQ(s.at("serverInfo").at("name"), "fieldguard");
-  for (const char* topic :
-       {"/lidar/points", "/detection/points", "/detection/obstacles", "/detection/zones", "/safety/decision"}) {
+  for (const char* topic : {"/lidar/points", "/detection/points", "/detection/obstacles", "/detection/zones",
+                            "/safety/decision", "/health"}) {
     EXPECT_GT(s.at("messages").value(topic, 0), 0) << topic << ": " << client.output;
   }
   // What the client decoded is what the daemon decided and recorded, frame by frame, and it saw a stop for the

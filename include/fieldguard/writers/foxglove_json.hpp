@@ -2,11 +2,11 @@
 // A processed frame as Foxglove messages, JSON-encoded (MCAP message encoding "json", schema encoding
 // "jsonschema"): the shapes of Foxglove's well-known schemas (foxglove.PointCloud, foxglove.SceneUpdate,
 // foxglove.FrameTransform, foxglove.LocationFix), so Foxglove and Lichtblick draw them without a plugin, and
-// fieldguard's own fieldguard.Decision. JSON and not protobuf: no protobuf library or generated code in the
-// daemon, every message readable as text, and each message checked against @foxglove/schemas' JSON schemas by
-// a test (tests/interop/node/mcap_check.mjs). What it costs: a point cloud's bytes are base64 (4/3 as many,
-// before the chunk's compression). Each schema's text, written for fieldguard from the fields it writes, goes
-// into the file with its messages (schemas()).
+// fieldguard's own fieldguard.Decision and fieldguard.Health. JSON and not protobuf: no protobuf library or generated
+// code in the daemon, every message readable as text, and each message checked against @foxglove/schemas' JSON schemas
+// by a test (tests/interop/node/mcap_check.mjs). What it costs: a point cloud's bytes are base64 (4/3 as many, before
+// the chunk's compression). Each schema's text, written for fieldguard from the fields it writes, goes into the file
+// with its messages (schemas()).
 
 #include <cstdint>
 #include <optional>
@@ -62,6 +62,15 @@ void decision(std::string& out, std::int64_t stamp_ns, std::uint64_t frame, cons
 // foxglove.FrameTransform field -> lidar from a fused frame's detection pose, less `origin` (east, north, up).
 void frame_transform(std::string& out, std::int64_t stamp_ns, const perception::FramePose& pose,
                      const std::array<double, 3>& origin);
+// One sensor as the daemon reports it: "lidar", "ok" | "silent 1.4 s" | "never heard" | "off", its rate.
+struct SensorState {
+  std::string name;
+  std::string state;
+  double rate_hz = 0.0;
+};
+// fieldguard.Health: {timestamp, sensors [{name, state, rate_hz}], status (the STATUS= line)}. The texts are the
+// daemon's own words and numbers: nothing JSON must escape.
+void health(std::string& out, std::int64_t stamp_ns, std::span<const SensorState> sensors, std::string_view status);
 // foxglove.LocationFix of the vehicle's reference point (WGS84 degrees, ellipsoidal height).
 void location_fix(std::string& out, std::int64_t stamp_ns, const geo::Geodetic& g);
 

@@ -9,6 +9,8 @@
 //   /safety/decision       fieldguard.Decision     stop or go, the reasons, the headline
 //   /tf                    foxglove.FrameTransform field -> lidar, for a fused frame levelled in full
 //   /gnss/fix              foxglove.LocationFix    that frame's reference point in WGS84
+//   /health                fieldguard.Health       each sensor's state and rate, the status line (the daemon's, once a
+//                                                  second and on a change of decision; encode() writes none)
 // Thread-compatible.
 
 #include <array>
@@ -30,8 +32,8 @@ struct FrameChannel {
   std::string_view topic;
   std::string_view schema;  // a name of foxglove::schemas()
 };
-enum class Topic : std::uint8_t { RawPoints, LabelledPoints, Obstacles, Zones, Decision, Transform, Fix };
-inline constexpr std::array<FrameChannel, 7> kFrameChannels = {{
+enum class Topic : std::uint8_t { RawPoints, LabelledPoints, Obstacles, Zones, Decision, Transform, Fix, Health };
+inline constexpr std::array<FrameChannel, 8> kFrameChannels = {{
     {"/lidar/points", "foxglove.PointCloud"},
     {"/detection/points", "foxglove.PointCloud"},
     {"/detection/obstacles", "foxglove.SceneUpdate"},
@@ -39,6 +41,7 @@ inline constexpr std::array<FrameChannel, 7> kFrameChannels = {{
     {"/safety/decision", "fieldguard.Decision"},
     {"/tf", "foxglove.FrameTransform"},
     {"/gnss/fix", "foxglove.LocationFix"},
+    {"/health", "fieldguard.Health"},
 }};
 
 class FrameEncoder {
