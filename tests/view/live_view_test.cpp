@@ -154,7 +154,12 @@ TEST_F(LiveViewTest, FramesFromAnotherThreadReachTheRecordingAndAReadingClient) 
     // Waits, never a timing verdict: under ThreadSanitizer on a loaded machine the messages take their time.
     for (int k = 0; k < 3000 && client.messages() < 20; ++k) std::this_thread::sleep_for(10ms);
     EXPECT_GE(client.messages(), 20);
-    counts = view.counts();
+    // Every frame the view accepted is recorded once its thread has drained the ring (the counts lag until then).
+    for (int k = 0; k < 3000; ++k) {
+      counts = view.counts();
+      if (counts.mcap.frames + counts.dropped == 60U) break;
+      std::this_thread::sleep_for(10ms);
+    }
   }
   EXPECT_EQ(counts.frames, 60U);
   EXPECT_GT(counts.mcap.frames, 0U);
