@@ -116,18 +116,20 @@ void LiveView::show_status() {
   // On the timeline too: a recording and a viewer see the stop a silent sensor caused between frames.
   foxglove::decision(message_, page_stamp_.ns, page_frame_, page_decision_, cfg_.safety.clear_frames, true);
   last_decision_ns_ = std::max(page_stamp_.ns, last_decision_ns_);
-  const auto t = static_cast<std::uint64_t>(std::max<std::int64_t>(last_decision_ns_, 0));
-  if (mcap_ && !mcap_failed_) mcap_->message(Topic::Decision, last_decision_ns_, message_);
-  const auto ch = static_cast<std::size_t>(Topic::Decision);
-  if (server_ && server_->subscribed(ch)) server_->publish(ch, t, std::make_shared<const std::string>(message_));
-  // The sensors too, on their own channel.
-  const auto h = static_cast<std::size_t>(Topic::Health);
-  if (mcap_ && !mcap_failed_) mcap_->message(Topic::Health, page_stamp_.ns, health);
-  if (server_ && server_->subscribed(h)) {
-    server_->publish(h, static_cast<std::uint64_t>(std::max<std::int64_t>(page_stamp_.ns, 0)),
-                     std::make_shared<const std::string>(std::move(health)));
-  }
+  const bool recording = mcap_ && !mcap_failed_;
+  send(Topic::Decision, last_decision_ns_, message_, recording);
+  send(Topic::Health, page_stamp_.ns, health, recording);  // the sensors too, on their own channel
   if (server_) server_->set_page(page_json(), nullptr);
+}
+
+void LiveView::send(Topic topic, std::int64_t t, std::string_view json, bool record) {
+  if (record) mcap_->message(topic, t, json);
+  const auto ch = static_cast<std::size_t>(topic);
+  // A message nobody subscribes to is not even copied.
+  if (server_ && server_->subscribed(ch)) {
+    server_->publish(ch, static_cast<std::uint64_t>(std::max<std::int64_t>(t, 0)),
+                     std::make_shared<const std::string>(json));
+  }
 }
 
 void LiveView::loop() {
@@ -155,12 +157,7 @@ void LiveView::show(Slot& s) {
                     // A decision taken on the clock may be later than the next frame's stamp (its first packet):
                     // the channel's log times still never go back.
                     if (topic == Topic::Decision) t = last_decision_ns_ = std::max(t, last_decision_ns_);
-                    if (recording) mcap_->message(topic, t, json);
-                    const auto ch = static_cast<std::size_t>(topic);
-                    if (server_ && server_->subscribed(ch)) {
-                      server_->publish(ch, static_cast<std::uint64_t>(std::max<std::int64_t>(t, 0)),
-                                       std::make_shared<const std::string>(json));
-                    }
+                    send(topic, t, json, recording);
                   });
   if (mcap_ && !mcap_failed_) {
     if (!mcap_->error().empty()) {
@@ -180,12 +177,10 @@ void LiveView::show(Slot& s) {
     const std::int64_t now = steady_ns();
     if (server_->page_watched() && now - last_picture_ns_ >= kPictureEvery_ns) {
       last_picture_ns_ = now;
-      const auto& z = s.decision.zone;
-      const perception::Box3 zone{{z.x_min_m, -z.half_width_m, -10.0}, {z.x_max_m, z.half_width_m, 10.0}};
       const BevCaption caption{s.frame.index, s.frame.host_stamp, s.frame.partial, &s.decision,
                                cfg_.safety.clear_frames};
       png = std::make_shared<const std::vector<std::uint8_t>>(
-          render_bev(s.labelled, result.obstacles, cfg_.perception, zone, caption).png());
+          render_bev(s.labelled, result.obstacles, cfg_.perception, stop_zone_box(s.decision.zone), caption).png());
     }
     page_decision_ = s.decision;
     page_frame_ = s.frame.index;

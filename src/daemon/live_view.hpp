@@ -72,6 +72,8 @@ class LiveView {
   void loop();
   void show(Slot& s);
   void show_status();  // the status() handed over, on the view thread
+  // One message to the recording (when `record`) and to the server's subscribers.
+  void send(Topic topic, std::int64_t t, std::string_view json, bool record);
   [[nodiscard]] std::string page_json();
 
   const Config cfg_;

@@ -211,9 +211,10 @@ void Session::on_tick(std::chrono::nanoseconds late) {
     last_status_ = SteadyClock::now();
   } else if (SteadyClock::now() - last_status_ >= kStatusEvery) {
     last_status_ = SteadyClock::now();
-    notify_.status(status(now));
+    std::string line = status(now);
+    notify_.status(line);
     if (view_ && stage_.last_decision()) {
-      view_->status(*stage_.last_decision(), now, view_sensors(now), status(now));
+      view_->status(*stage_.last_decision(), now, view_sensors(now), std::move(line));
       view_shown_ = std::pair(stage_.last_decision()->stop, stage_.last_decision()->reason);
     }
     // With the status, and only between frames: the pool's slots a burst filled (frames released together after
@@ -235,6 +236,7 @@ void Session::on_tick(std::chrono::nanoseconds late) {
 }
 
 std::vector<ViewSensor> Session::view_sensors(Stamp now) const {
+  // Silence as the safety monitor judges it (every datagram of the 3D LiDAR counts, not only whole rotations).
   std::vector<ViewSensor> out;
   for (std::size_t i = 0; i < safety::kSensorCount; ++i) {
     const auto s = static_cast<safety::Sensor>(i);
@@ -267,24 +269,15 @@ std::string Session::status(Stamp now) const {
   const auto fault = [&faults](const std::string& f) { faults += (faults.empty() ? "" : ", ") + f; };
   std::uint8_t off = 0;
   char buf[128];
-  for (std::size_t i = 0; i < safety::kSensorCount; ++i) {
+  // Each sensor as the page lists it: silence as the safety monitor judges it.
+  const std::vector<ViewSensor> sensors = view_sensors(now);
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
     const auto s = static_cast<safety::Sensor>(i);
-    const auto k = kind_of(s);
-    if (!enabled(cfg_, s)) {
-      off = static_cast<std::uint8_t>(off | sync::bit(k));
-      continue;
+    if (sensors[i].state == "off") {
+      off = static_cast<std::uint8_t>(off | sync::bit(kind_of(s)));
+    } else if (sensors[i].state != "ok") {
+      fault(sensors[i].name + " " + sensors[i].state + (cfg_.safety.sensor(s).required ? "" : " (not required)"));
     }
-    // Silence as the safety monitor judges it (every datagram of the 3D LiDAR counts, not only whole rotations).
-    const auto& p = cfg_.safety.sensor(s);
-    const Stamp last = stage_.last_data(s);
-    const auto age = last.ns == 0 ? std::nullopt : std::optional<double>(static_cast<double>(now.ns - last.ns) * 1e-9);
-    if (age && *age <= p.timeout_s) continue;
-    if (age) {
-      std::snprintf(buf, sizeof buf, "%s silent %.1f s", std::string(safety::to_string(s)).c_str(), *age);
-    } else {
-      std::snprintf(buf, sizeof buf, "%s never heard", std::string(safety::to_string(s)).c_str());
-    }
-    fault(std::string(buf) + (p.required ? "" : " (not required)"));
   }
   if (stalled_) fault("pipeline stalled");
   if (const sync::Synchronizer* sy = fusion_.synchronizer()) {

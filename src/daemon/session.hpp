@@ -95,7 +95,7 @@ class Session {
   void process(FrameJob& j, DetectedFrame& d);  // over the slot's earlier result (OrderedPool::ProcessInto)
 
   void heard(output::safety::Sensor s, Stamp t);
-  // Each sensor's state and rate, for the live view's page.
+  // Each sensor's state and rate, for the live view's page and the status line's faults.
   [[nodiscard]] std::vector<ViewSensor> view_sensors(Stamp now) const;
 
   void on_datagram(const io::UdpDatagram& d);

@@ -394,24 +394,19 @@ void Replay::write_frame(const Pool::Result& r) {
   times_.push_back(result.times);
   // Decided before the obstacles line is written: the line carries the decision.
   if (can_) decide(r, f, result);
+  const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
   if (obstacles_out_.is_open() && write_error_.empty()) {
-    const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
     obstacles_out_ << obstacles_json_line(f, result, fused, &cfg_.lidar.mounting, decision, cfg_.safety.clear_frames)
                    << '\n';
     if (!obstacles_out_) write_error_ = "cannot write " + *opt_.obstacles_out;
   }
   if (geojson_ && write_error_.empty() && !geojson_->frame(f, result, fused)) write_error_ = geojson_->error();
   if (mcap_ && write_error_.empty()) {
-    const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
     if (!mcap_->frame(f, result, r.output->det.labelled, fused, decision)) write_error_ = mcap_->error();
   }
   if (!bev_dir_.empty() && write_error_.empty()) {
-    const output::safety::Decision* decision = can_ && can_->last_decision() ? &*can_->last_decision() : nullptr;
-    std::optional<perception::Box3> zone;
-    if (decision != nullptr) {
-      zone = perception::Box3{{decision->zone.x_min_m, -decision->zone.half_width_m, -10.0},
-                              {decision->zone.x_max_m, decision->zone.half_width_m, 10.0}};
-    }
+    const std::optional<perception::Box3> zone =
+        decision != nullptr ? std::optional(stop_zone_box(decision->zone)) : std::nullopt;
     const BevCaption caption{f.index, f.host_stamp, f.partial, decision, cfg_.safety.clear_frames};
     write_error_ = render_bev(r.output->det.labelled, result.obstacles, cfg_.perception, zone, caption)
                        .write_png((fs::path(bev_dir_) / (std::string(stem) + ".png")).string());

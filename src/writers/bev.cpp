@@ -362,6 +362,10 @@ std::vector<std::uint8_t> Picture::png() const {
   return out;
 }
 
+perception::Box3 stop_zone_box(const output::safety::Zone& z) {
+  return {{z.x_min_m, -z.half_width_m, -10.0}, {z.x_max_m, z.half_width_m, 10.0}};
+}
+
 Picture render_bev(std::span<const perception::LabeledPoint> points, std::span<const perception::Obstacle> obstacles,
                    const perception::PipelineParams& params, const std::optional<perception::Box3>& stop_zone,
                    const BevCaption& caption, const BevView& view) {

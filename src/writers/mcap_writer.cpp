@@ -121,16 +121,22 @@ bool McapWriter::open(const std::string& path, McapOptions options) {
   return error_.empty();
 }
 
-std::uint16_t McapWriter::add_schema(std::string_view name, std::string_view encoding, std::string_view data) {
-  if (file_ == nullptr) return 0;
-  schemas_.push_back({std::string(name), std::string(encoding), std::string(data)});
-  const auto id = static_cast<std::uint16_t>(schemas_.size());
+namespace {
+std::string schema_content(std::uint16_t id, std::string_view name, std::string_view encoding, std::string_view data) {
   std::string c;
   put<std::uint16_t>(c, id);
   put_string(c, name);
   put_string(c, encoding);
   put_string(c, data);  // uint32 length-prefixed bytes: the same shape as a string
-  emit(record(kSchema, c));
+  return c;
+}
+}  // namespace
+
+std::uint16_t McapWriter::add_schema(std::string_view name, std::string_view encoding, std::string_view data) {
+  if (file_ == nullptr) return 0;
+  schemas_.push_back({std::string(name), std::string(encoding), std::string(data)});
+  const auto id = static_cast<std::uint16_t>(schemas_.size());
+  emit(record(kSchema, schema_content(id, name, encoding, data)));
   return id;
 }
 
@@ -287,12 +293,8 @@ bool McapWriter::close() {
   };
   std::vector<std::string> contents;
   for (std::size_t i = 0; i < schemas_.size(); ++i) {
-    std::string c;
-    put<std::uint16_t>(c, static_cast<std::uint16_t>(i + 1));
-    put_string(c, schemas_[i].name);
-    put_string(c, schemas_[i].encoding);
-    put_string(c, schemas_[i].data);
-    contents.push_back(std::move(c));
+    const Schema& sc = schemas_[i];
+    contents.push_back(schema_content(static_cast<std::uint16_t>(i + 1), sc.name, sc.encoding, sc.data));
   }
   summary(kSchema, contents);
   contents.clear();

@@ -75,6 +75,9 @@ class Picture {
   _cairo_surface* surface_ = nullptr;
 };
 
+// The safety monitor's zone as the box render_bev draws (every height).
+[[nodiscard]] perception::Box3 stop_zone_box(const output::safety::Zone& z);
+
 [[nodiscard]] Picture render_bev(std::span<const perception::LabeledPoint> points,
                                  std::span<const perception::Obstacle> obstacles,
                                  const perception::PipelineParams& params,
