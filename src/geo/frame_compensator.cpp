@@ -13,6 +13,27 @@ namespace fieldguard::geo {
 
 namespace {
 
+// Fixes without an altitude take the height of the nearest earlier fix of the frame that has one (of the first
+// later one when none before); with none at all every height stays 0: no vertical motion, rather than a jump.
+void fill_missing_heights(std::vector<CompensationWork::Fix>& fixes) {
+  const CompensationWork::Fix* known = nullptr;
+  for (const auto& f : fixes) {
+    if (f.has_height) {
+      known = &f;
+      break;
+    }
+  }
+  if (known == nullptr) return;
+  double up = known->plane.up_m;
+  for (auto& f : fixes) {
+    if (f.has_height) {
+      up = f.plane.up_m;
+    } else {
+      f.plane.up_m = up;
+    }
+  }
+}
+
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 void add_all(std::vector<std::string>& to, const std::vector<std::string>& from, const char* prefix) {
@@ -177,19 +198,22 @@ void FrameCompensator::compensate(const sync::SyncedFrame& frame, CompensatedFra
     const auto* gga = std::get_if<nmea::Gga>(&g.sentence);
     if (gga == nullptr) continue;
     if (!gga->quality || quality_rank(*gga->quality) == 0 ||
-        quality_rank(*gga->quality) < quality_rank(params_.min_gnss_quality) || !gga->lat_deg || !gga->lon_deg ||
-        !gga->alt_m) {
+        quality_rank(*gga->quality) < quality_rank(params_.min_gnss_quality) || !gga->lat_deg || !gga->lon_deg) {
       ++st.gnss_rejected;
       continue;
     }
-    const Geodetic geo{*gga->lat_deg, *gga->lon_deg, *gga->alt_m + gga->geoid_sep_m.value_or(0.0)};
+    // A position-only receiver (DGPS) leaves the altitude empty: a fix all the same. The plane position does not
+    // depend on the height; the height is taken from the frame's fixes that have one (below).
+    const Geodetic geo{*gga->lat_deg, *gga->lon_deg, gga->alt_m.value_or(0.0) + gga->geoid_sep_m.value_or(0.0)};
     auto plane = projection_.forward(geo);
     if (!plane) {
       ++st.gnss_rejected;
       continue;
     }
-    fixes.push_back(Fix{g.time, *plane});
+    if (!gga->alt_m) ++st.gnss_without_height;
+    fixes.push_back(Fix{g.time, *plane, gga->alt_m.has_value()});
   }
+  fill_missing_heights(fixes);
   const double convergence_deg = fixes.empty() ? 0.0 : fixes.front().plane.convergence_deg;
 
   if (!work.track || work.track_owner != this) {

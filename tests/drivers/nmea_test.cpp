@@ -191,6 +191,24 @@ TEST(NmeaGga, EmptyFieldsAreNotZeros) {
   EXPECT_EQ(zeros->alt_m, 4.0);
 }
 
+// A position-only DGPS receiver: quality 2 and a position, every optional field empty. A valid fix whose
+// optional fields are absent, not a bad field. And a real one (gpsd regress, telit-he910.log) with the geoid
+// separation empty.
+TEST(NmeaGga, PositionOnlyFixHasItsOptionalFieldsAbsent) {
+  const auto dgps = parse_gga("$GPGGA,123519.00,4807.0380,N,01131.0000,E,2,,,,,,,,*7E");
+  ASSERT_TRUE(dgps) << to_string(dgps.error());
+  EXPECT_EQ(dgps->quality, 2);
+  EXPECT_NEAR(*dgps->lat_deg, 48 + 7.038 / 60, 1e-12);
+  EXPECT_NEAR(*dgps->lon_deg, 11 + 31.0 / 60, 1e-12);
+  EXPECT_FALSE(dgps->satellites || dgps->hdop || dgps->alt_m || dgps->geoid_sep_m || dgps->dgps_age_s);
+
+  const auto telit = parse_gga("$GPGGA,105153.71,5050.4122,N,00420.8266,E,1,04,2.25,109.44,M,,M,,*77");
+  ASSERT_TRUE(telit) << to_string(telit.error());
+  EXPECT_EQ(telit->satellites, 4);
+  EXPECT_EQ(telit->alt_m, 109.44);
+  EXPECT_FALSE(telit->geoid_sep_m);
+}
+
 TEST(NmeaGga, AnyTalker) {
   const auto gl = parse_gga(kGlonassGga);
   ASSERT_TRUE(gl) << to_string(gl.error());

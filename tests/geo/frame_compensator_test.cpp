@@ -433,13 +433,56 @@ TEST(FrameCompensator, GnssQualityIsRankedByPrecisionNotByCode) {
     any.compensate(f, out);
     EXPECT_EQ(out.levelling, c.any ? Levelling::Full : Levelling::AttitudeOnly) << c.quality;
   }
-  // A GGA with an empty quality field or no altitude is no fix either.
+  // A GGA with an empty quality field is no fix either; one without an altitude is (a position-only receiver).
   sync::SyncedFrame f = make_frame(truth, rtk);
   std::get<nmea::Gga>(f.gnss[0].sentence).quality.reset();
   std::get<nmea::Gga>(f.gnss[1].sentence).alt_m.reset();
   any.compensate(f, out);
-  EXPECT_EQ(out.stats.gnss_rejected, 2U);
-  EXPECT_EQ(out.stats.gnss_used, 1U);
+  EXPECT_EQ(out.stats.gnss_rejected, 1U);
+  EXPECT_EQ(out.stats.gnss_used, 2U);
+  EXPECT_EQ(out.stats.gnss_without_height, 1U);
+}
+
+// A DGPS receiver that reports position only (GGA with satellites, HDOP, altitude and geoid separation empty)
+// still places and deskews the frame: the plane position needs no height. With no height in the frame at all
+// the reference stays at height 0 (no vertical motion); with one, the others take it.
+TEST(FrameCompensator, PositionOnlyFixesPlaceAndDeskewTheFrame) {
+  const CompensationParams params = base_params();
+  const FrameCompensator comp(params);
+  Truth truth;
+  truth.speed_mps = 3.0;
+  truth.yaw_grid_deg = 20.0;
+  sync::SyncedFrame f = make_frame(truth, params);
+  for (sync::TimedGnss& g : f.gnss) {
+    auto& gga = std::get<nmea::Gga>(g.sentence);
+    gga.satellites.reset();
+    gga.hdop.reset();
+    gga.alt_m.reset();
+    gga.geoid_sep_m.reset();
+  }
+  const Eigen::Vector3d post = truth.start + Eigen::Vector3d(8.0, 12.0, 1.0);
+  for (int i = 0; i <= 40; ++i) f.points.push_back(truth.seen(post, 0.005 * i, params.lidar));
+  CompensatedFrame out;
+  comp.compensate(f, out);
+  ASSERT_EQ(out.levelling, Levelling::Full);
+  EXPECT_EQ(out.stats.gnss_used, f.gnss.size());
+  EXPECT_EQ(out.stats.gnss_without_height, f.gnss.size());
+  const Eigen::Vector3d want = truth.expected(post, 0.2, params.lidar);
+  for (const auto& p : out.points) {
+    // Horizontally where the full fixes put it; the frame's height is the vehicle's at 0 instead of its own.
+    EXPECT_NEAR((xyz(p) - want).head<2>().norm(), 0.0, 3e-3) << "time_s " << p.time_s;
+  }
+  ASSERT_TRUE(out.reference.has_value());
+  EXPECT_NEAR(out.reference->easting_m, truth.p(0.2).x(), 1e-3);
+  EXPECT_NEAR(out.reference->northing_m, truth.p(0.2).y(), 1e-3);
+
+  // One fix with its altitude: the others take its height.
+  std::get<nmea::Gga>(f.gnss[0].sentence).alt_m = std::get<nmea::Gga>(make_frame(truth, params).gnss[0].sentence).alt_m;
+  std::get<nmea::Gga>(f.gnss[0].sentence).geoid_sep_m = kGeoidSep;
+  comp.compensate(f, out);
+  EXPECT_EQ(out.stats.gnss_without_height, f.gnss.size() - 1);
+  ASSERT_TRUE(out.reference.has_value());
+  EXPECT_NEAR(out.reference->up_m, truth.p(0.0).z(), 0.05);
 }
 
 TEST(FrameCompensator, NoAhrsLeavesPointsAsMounted) {

@@ -94,8 +94,9 @@ struct CompensationStats {
   DeskewStats lidar;  // 3D LiDAR points through deskew
   DeskewStats scan;   // lifted 2D points through deskew
   ScanLiftStats lift;
-  std::size_t gnss_used = 0;      // fixes that went into the track
-  std::size_t gnss_rejected = 0;  // GGA without a fix, below min_gnss_quality, not projectable, out of order
+  std::size_t gnss_used = 0;            // fixes that went into the track
+  std::size_t gnss_rejected = 0;        // GGA without a fix, below min_gnss_quality, not projectable, out of order
+  std::size_t gnss_without_height = 0;  // used, but the GGA had no altitude (its height from the frame's others)
   std::size_t ahrs_used = 0;
   std::size_t ahrs_rejected = 0;        // no Euler angles, not finite, out of order, reserved coordinate system
   std::size_t ahrs_frame_mismatch = 0;  // used, but the data id's frame differs from AhrsParams::frame
@@ -108,6 +109,7 @@ struct CompensationWork {
   struct Fix {  // one GGA fix that passed the checks, projected
     Stamp t;
     PlaneCoord plane;
+    bool has_height = true;  // the GGA had an altitude (a position-only receiver sends none)
   };
   struct AttSample {
     Stamp t;
