@@ -100,6 +100,17 @@ Expected<MsopHeader, DecodeError> read_msop_header(ByteSpan p) {
   return h;
 }
 
+const Calibration& nominal_calibration() {
+  static const Calibration kNominal = [] {
+    Calibration c;
+    c.vert_deg = {-10.26, 0.30,  -6.41, -0.02, 2.28,  -0.33,  3.30,  -0.67,  4.61,  1.68,  7.02,
+                  1.30,   10.30, 1.00,  15.02, 0.70,  -25.00, -2.28, -14.64, -2.67, -7.91, -3.02,
+                  -5.41,  -3.30, -3.65, -1.02, -4.05, -1.33,  -4.39, -1.63,  -4.65, -1.98};
+    return c;
+  }();
+  return kNominal;
+}
+
 Decoder::Decoder(DecoderOptions options) : options_(std::move(options)) {
   const auto& o = options_;
   if (!std::isfinite(o.min_range_m) || !std::isfinite(o.max_range_m) || o.min_range_m < 0.0 ||
@@ -112,6 +123,14 @@ Decoder::Decoder(DecoderOptions options) : options_(std::move(options)) {
   if (o.calibration) set_calibration(*o.calibration);
   if (o.distance_unit == DistanceUnitOption::HalfCm) unit_ = DistanceUnit::HalfCm;
   if (o.distance_unit == DistanceUnitOption::OneCmGrouped) unit_ = DistanceUnit::OneCmGrouped;
+  if (o.nominal_until_difop && !o.calibration) {
+    set_calibration(nominal_calibration());
+    nominal_ = true;
+  }
+  if (o.nominal_until_difop && !unit_) {
+    unit_ = DistanceUnit::HalfCm;
+    unit_assumed_ = true;
+  }
   return_mode_ = o.return_mode;
 }
 
@@ -135,9 +154,13 @@ void Decoder::set_calibration(const Calibration& c) {
 bool Decoder::apply(const DifopInfo& d) {
   rpm_ = d.rpm != 0 ? d.rpm : std::uint16_t{600};
   if (!options_.return_mode) return_mode_ = d.return_mode;
-  if (options_.distance_unit == DistanceUnitOption::Auto && !unit_) unit_ = d.distance_unit;
+  if (options_.distance_unit == DistanceUnitOption::Auto && (!unit_ || unit_assumed_)) {
+    unit_ = d.distance_unit;
+    unit_assumed_ = false;
+  }
   if (!d.calibration) return false;
-  if (!calibration_) {
+  if (!calibration_ || nominal_) {
+    nominal_ = false;
     set_calibration(*d.calibration);  // parse_difop checked the range, so this cannot throw
     return false;
   }

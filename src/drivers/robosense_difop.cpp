@@ -1,8 +1,11 @@
 // RoboSense RS-32 DIFOP (device information) packet (protocols.md §2.3; rs_driver RS32DifopPkt).
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <string>
+#include <string_view>
 
 #include "fieldguard/drivers/robosense.hpp"
 
@@ -73,6 +76,44 @@ Expected<DifopInfo, DecodeError> parse_difop(ByteSpan p) {
   }
   d.calibration = cal;
   return d;
+}
+
+// angle.csv: one channel a line; blank lines and a trailing newline are allowed, nothing else.
+Expected<Calibration, std::string> parse_angle_csv(std::string_view text) {
+  Calibration c;
+  std::size_t channel = 0;
+  std::size_t line_no = 0;
+  while (!text.empty()) {
+    const std::size_t end = std::min(text.find('\n'), text.size());
+    std::string line(text.substr(0, end));
+    text.remove_prefix(std::min(end + 1, text.size()));
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    const auto bad = [&](const std::string& why) {
+      return Unexpected{"angle.csv line " + std::to_string(line_no) + ": " + why};
+    };
+    if (channel == kChannels) return bad("more than 32 channels");
+    const std::size_t comma = line.find(',');
+    std::array<double, 2> v{0.0, 0.0};
+    const std::array<std::string, 2> fields = {line.substr(0, comma),
+                                               comma == std::string::npos ? "0" : line.substr(comma + 1)};
+    for (std::size_t i = 0; i < 2; ++i) {
+      char* stop = nullptr;
+      v[i] = std::strtod(fields[i].c_str(), &stop);
+      if (stop == fields[i].c_str() || std::string_view(stop).find_first_not_of(" \t") != std::string_view::npos ||
+          !std::isfinite(v[i]) || std::abs(v[i]) >= 90.0) {
+        return bad("'" + fields[i] + "' is not an angle in degrees between -90 and 90");
+      }
+    }
+    c.vert_deg[channel] = v[0];
+    c.horiz_deg[channel] = v[1];
+    ++channel;
+  }
+  if (channel != kChannels) {
+    return Unexpected{"angle.csv has " + std::to_string(channel) + " channels; an RS-32's has 32 lines"};
+  }
+  return c;
 }
 
 }  // namespace fieldguard::robosense

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -119,8 +120,22 @@ struct MsopHeader {
 // Validates length, magic, block flags, azimuths and the timestamp.
 [[nodiscard]] Expected<MsopHeader, DecodeError> read_msop_header(ByteSpan payload);
 
+// Nominal angles for the time before the first DIFOP (DecoderOptions::nominal_until_difop): the vertical angles of
+// ros_rslidar's example rs_lidar_32/angle.csv (protocols.md §2.4: one real unit, rounded to 0.01 degree; RoboSense
+// publishes no fixed table, every unit has its own), no horizontal corrections. Off by up to a few tenths of a
+// degree from any other unit: good enough to see obstacles for the second until the unit's own table arrives.
+[[nodiscard]] const Calibration& nominal_calibration();
+
+// The unit's angle.csv (rs_driver, ros_rslidar): 32 lines, channel 0 first, each the vertical angle and, when
+// there, a comma and the horizontal correction, in degrees. An error names the line.
+[[nodiscard]] Expected<Calibration, std::string> parse_angle_csv(std::string_view text);
+
 struct DecoderOptions {
   std::optional<Calibration> calibration;  // a configured table (the unit's angle.csv); it wins over DIFOP's
+  // Without a configured table: decode with nominal_calibration() (and the 0.5 cm unit of every firmware since
+  // 2018 when distance_unit is Auto) until the first DIFOP brings the unit's own. Off: wait for it (rs_driver's
+  // wait_for_difop), NoCalibration until then.
+  bool nominal_until_difop = false;
   DistanceUnitOption distance_unit = DistanceUnitOption::Auto;
   std::optional<ReturnMode> return_mode;  // none = from DIFOP; before one, from the block layout
   double min_range_m = 0.4;               // rs_driver's RS-32 distance section: 0.4 .. 230 m
@@ -138,6 +153,7 @@ class Decoder {
 
   // Takes what a DIFOP says. The angle table and the distance unit are taken from the first DIFOP that has
   // them (rs_driver and ros_rslidar do the same) unless configured; return mode and rpm from every DIFOP.
+  // The nominal table and unit (nominal_until_difop) give way to the first DIFOP's.
   // Returns true when the DIFOP's angle table differs from the one in use by more than 0.0005 degree (the
   // caller counts it).
   bool apply(const DifopInfo& difop);
@@ -149,6 +165,7 @@ class Decoder {
   Expected<MsopHeader, DecodeError> decode(ByteSpan payload, std::vector<LidarPoint>& out) const;
 
   [[nodiscard]] const std::optional<Calibration>& calibration() const { return calibration_; }
+  [[nodiscard]] bool nominal() const { return nominal_; }  // decoding with the nominal table, no DIFOP's yet
   [[nodiscard]] std::optional<DistanceUnit> distance_unit() const { return unit_; }
   [[nodiscard]] std::optional<ReturnMode> return_mode() const { return return_mode_; }
   [[nodiscard]] std::uint16_t rpm() const { return rpm_; }
@@ -158,7 +175,9 @@ class Decoder {
 
   DecoderOptions options_;
   std::optional<Calibration> calibration_;
+  bool nominal_ = false;  // calibration_ is nominal_calibration(): the first DIFOP with angles replaces it
   std::optional<DistanceUnit> unit_;
+  bool unit_assumed_ = false;  // unit_ is the nominal one: the first DIFOP replaces it
   std::optional<ReturnMode> return_mode_;
   std::uint16_t rpm_ = 600;  // rs_driver's default when DIFOP says 0
   struct Channel {
