@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <numbers>
 #include <sstream>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "config/config_safety.hpp"
@@ -37,6 +39,7 @@ std::string read_text_file(const fs::path& p, std::string& error) {
   return s.str();
 }
 
+// The Velodyne calibration file (ROS .yaml, VeloView .xml) or the RS-32's angle.csv.
 void load_calibration(YamlReader& r, const YAML::Node& lidar, const std::string& config_dir, LidarConfig& c) {
   if (c.calibration_file.empty()) return;
   const int line = YamlReader::line_of(lidar, "calibration_file");
@@ -46,11 +49,25 @@ void load_calibration(YamlReader& r, const YAML::Node& lidar, const std::string&
   const std::string text = read_text_file(p, err);
   if (!err.empty()) {
     r.issues().push_back({r.file(), line, "lidar.calibration_file",
-                          err + "; give a path to a ROS calibration .yaml or a VeloView .xml (relative paths are "
-                                "taken from the config file's folder), or leave it empty for the built-in table"});
+                          err + "; give a path to a ROS calibration .yaml or a VeloView .xml (Velodyne) or the "
+                                "unit's angle.csv (RS-32; relative paths are taken from the config file's folder), "
+                                "or leave it empty for the built-in table"});
     return;
   }
   const auto ext = p.extension().string();
+  if (ext == ".csv") {
+    auto rs = robosense::parse_angle_csv(text);
+    if (!rs) {
+      r.issues().push_back({r.file(), line, "lidar.calibration_file", p.string() + ": " + rs.error()});
+    } else if (c.model != lidar3d::Model::RS32) {
+      r.issues().push_back({r.file(), line, "lidar.calibration_file",
+                            p.string() + " is an RS-32 angle table; it needs lidar.model: RS-32 (auto cannot know "
+                                         "the table fits the sensor it finds)"});
+    } else {
+      c.rs32_calibration = std::move(rs).value();
+    }
+    return;
+  }
   auto parsed = (ext == ".xml") ? velodyne::parse_veloview_calibration(text) : velodyne::parse_ros_calibration(text);
   if (!parsed) {
     r.issues().push_back({r.file(), line, "lidar.calibration_file", p.string() + ": " + parsed.error()});
@@ -58,10 +75,12 @@ void load_calibration(YamlReader& r, const YAML::Node& lidar, const std::string&
   }
   c.calibration = std::move(parsed).value();
   c.has_calibration = true;
-  if (c.model != velodyne::Model::Unknown && c.calibration.model != c.model) {
+  const auto file_model =
+      c.calibration.model == velodyne::Model::VLP16 ? lidar3d::Model::VLP16 : lidar3d::Model::HDL32E;
+  if (c.model != lidar3d::Model::Auto && file_model != c.model) {
     r.issues().push_back({r.file(), line, "lidar.calibration_file",
                           p.string() + " is a " + std::string(velodyne::to_string(c.calibration.model)) +
-                              " calibration but lidar.model is " + std::string(velodyne::to_string(c.model)) +
+                              " calibration but lidar.model is " + std::string(lidar3d::to_string(c.model)) +
                               "; use the file that came with this sensor"});
   }
 }
@@ -69,16 +88,20 @@ void load_calibration(YamlReader& r, const YAML::Node& lidar, const std::string&
 void read_lidar(YamlReader& r, const YAML::Node& n, const std::string& config_dir, LidarConfig& c) {
   const std::string path = "lidar";
   if (!r.section(n, path,
-                 {"model", "calibration_file", "data_port", "position_port", "timestamp_reference", "min_range_m",
-                  "max_range_m", "rotation_cut_deg", "mounting"})) {
+                 {"model", "calibration_file", "data_port", "position_port", "msop_port", "difop_port",
+                  "timestamp_reference", "min_range_m", "max_range_m", "rotation_cut_deg", "mounting"})) {
     return;
   }
-  if (auto m = r.choice(n, path, "model", {"auto", "HDL-32E", "VLP-16"})) {
-    c.model = *m == 0 ? velodyne::Model::Unknown : (*m == 1 ? velodyne::Model::HDL32E : velodyne::Model::VLP16);
+  if (auto m = r.choice(n, path, "model", {"auto", "HDL-32E", "VLP-16", "RS-32"})) {
+    static constexpr std::array<lidar3d::Model, 4> kModels = {lidar3d::Model::Auto, lidar3d::Model::HDL32E,
+                                                              lidar3d::Model::VLP16, lidar3d::Model::RS32};
+    c.model = kModels.at(static_cast<std::size_t>(*m));
   }
   r.text(n, path, "calibration_file", c.calibration_file);
   r.port(n, path, "data_port", c.data_port);
   r.port(n, path, "position_port", c.position_port);
+  r.port(n, path, "msop_port", c.msop_port);
+  r.port(n, path, "difop_port", c.difop_port);
   if (auto t = r.choice(n, path, "timestamp_reference", {"first_firing", "last_firing"})) {
     c.timestamp_reference =
         *t == 0 ? velodyne::TimestampReference::FirstFiring : velodyne::TimestampReference::LastFiring;
@@ -92,10 +115,19 @@ void read_lidar(YamlReader& r, const YAML::Node& n, const std::string& config_di
     r.issue(n["max_range_m"] ? n["max_range_m"] : n, "lidar.max_range_m",
             "must be greater than lidar.min_range_m; returns between the two are kept");
   }
-  if (c.data_port == c.position_port) {
-    r.issue(n["position_port"] ? n["position_port"] : n, "lidar.position_port",
-            "is the same as lidar.data_port; the sensor sends data and position packets to different ports "
-            "(2368 and 8308 by default)");
+  // Every port its own (0 = the kernel chooses one, live): the sensors send each kind to its own port.
+  const std::array<std::pair<const char*, std::uint16_t>, 4> ports = {{{"data_port", c.data_port},
+                                                                       {"position_port", c.position_port},
+                                                                       {"msop_port", c.msop_port},
+                                                                       {"difop_port", c.difop_port}}};
+  for (std::size_t i = 1; i < ports.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (ports[i].second == 0 || ports[i].second != ports[j].second) continue;
+      r.issue(n[ports[i].first] ? n[ports[i].first] : n, std::string("lidar.") + ports[i].first,
+              std::string("is the same as lidar.") + ports[j].first +
+                  "; each kind of datagram has its own port (Velodyne data 2368, position 8308; RS-32 MSOP 6699, "
+                  "DIFOP 7788 by default)");
+    }
   }
   load_calibration(r, n, config_dir, c);
 }

@@ -65,7 +65,14 @@ int record(const RecordOptions& opt) {
   };
   std::vector<std::unique_ptr<io::UdpReceiver>> udp;
   try {
-    for (std::uint16_t port : {cfg.lidar.data_port, cfg.lidar.position_port}) {
+    // The configured model's ports; both families' while it is to be found out (auto).
+    std::vector<std::uint16_t> ports;
+    if (cfg.lidar.model != lidar3d::Model::RS32)
+      ports.insert(ports.end(), {cfg.lidar.data_port, cfg.lidar.position_port});
+    if (cfg.lidar.model == lidar3d::Model::RS32 || cfg.lidar.model == lidar3d::Model::Auto) {
+      ports.insert(ports.end(), {cfg.lidar.msop_port, cfg.lidar.difop_port});
+    }
+    for (std::uint16_t port : ports) {
       io::UdpReceiverOptions o;
       o.port = port;
       udp.push_back(std::make_unique<io::UdpReceiver>(io, o, on_udp));

@@ -64,14 +64,35 @@ Session::~Session() {
   waker_->session = nullptr;  // a wake-up still queued on the io thread finds nobody
 }
 
-std::uint16_t Session::lidar_port() const { return udp_ ? udp_->local_port() : 0; }
+std::uint16_t Session::lidar_port(lidar3d::Channel channel) const {
+  const auto& u = udp_[static_cast<std::size_t>(channel)];
+  return u ? u->local_port() : 0;
+}
 
 void Session::start() {
   const Stamp now = wall_clock_now();
-  io::UdpReceiverOptions o;
-  o.port = cfg_.lidar.data_port;
-  udp_ = std::make_unique<io::UdpReceiver>(io_, o, [this](const io::UdpDatagram& d) { on_datagram(d); });
-  udp_->start();
+  // The ports of the configured model; all three while it is to be found out (auto).
+  const lidar3d::Model model = cfg_.lidar.model;
+  const bool velodyne = model != lidar3d::Model::RS32;
+  const bool robosense = model == lidar3d::Model::RS32 || model == lidar3d::Model::Auto;
+  const std::array<std::pair<lidar3d::Channel, std::uint16_t>, 3> channels = {{
+      {lidar3d::Channel::VelodyneData, velodyne ? cfg_.lidar.data_port : std::uint16_t{0}},
+      {lidar3d::Channel::Msop, robosense ? cfg_.lidar.msop_port : std::uint16_t{0}},
+      {lidar3d::Channel::Difop, robosense ? cfg_.lidar.difop_port : std::uint16_t{0}},
+  }};
+  std::string ports;
+  for (const auto& [channel, port] : channels) {
+    const bool wanted = channel == lidar3d::Channel::VelodyneData ? velodyne : robosense;
+    if (!wanted) continue;
+    io::UdpReceiverOptions o;
+    o.port = port;
+    auto& u = udp_[static_cast<std::size_t>(channel)];
+    u = std::make_unique<io::UdpReceiver>(io_, o, [this, c = channel](const io::UdpDatagram& d) { on_datagram(c, d); });
+    u->start();
+    static constexpr std::array<const char*, 3> kNames = {"Velodyne data", "RS-32 MSOP", "RS-32 DIFOP"};
+    ports += (ports.empty() ? "" : ", ") + std::to_string(u->local_port()) + " (" +
+             kNames[static_cast<std::size_t>(channel)] + ")";
+  }
   if (view_wanted_) {
     view_ = std::make_unique<LiveView>(cfg_);  // throws when the recording or the port cannot be opened
     if (!cfg_.view.mcap_path.empty()) {
@@ -83,7 +104,7 @@ void Session::start() {
                  cfg_.view.address, *port);
     }
   }
-  log_->info("listening for the 3D LiDAR on udp port {}; {}", udp_->local_port(),
+  log_->info("listening for the 3D LiDAR on udp port {}, model {}; {}", ports, lidar3d::to_string(model),
              fusion_.fused() ? "frames fused from every enabled sensor at " + std::to_string(cfg_.sync.rate_hz) + " Hz"
                              : std::string("one frame per rotation"));
   if (cfg_.scan2d.enabled) {
@@ -155,7 +176,9 @@ void Session::start_speed_input() {
 void Session::stop() {
   if (stopped_) return;
   stopped_ = true;
-  if (udp_) udp_->stop();
+  for (auto& u : udp_) {
+    if (u) u->stop();
+  }
   if (scip_) scip_->stop();
   if (can_in_) can_in_->stop();
   for (auto& s : serial_) s->stop();
@@ -322,7 +345,11 @@ void Session::print_summary() const {
       "spare buffers gave their memory back\n",
       u(pc.submitted), u(pc.dropped), u(pc.refused), u(pc.failed), u(trimmed_slots_), u(trimmed_spares_));
   std::printf("  3d lidar          %llu packets, %llu decoded, %llu bad length, %llu full rotations, %llu partial\n",
-              u(sc.packets), u(sc.decoded), u(bad_length_), u(sc.full_rotations), u(sc.partial_rotations));
+              u(sc.data_packets), u(sc.decoded), u(bad_length_), u(sc.full_rotations), u(sc.partial_rotations));
+  const lidar3d::Stream& stream = fusion_.stream();
+  std::printf("  3d lidar model    %s (%s); %llu refused, %llu of another family, %llu DIFOP\n",
+              stream.model() ? std::string(lidar3d::to_string(*stream.model())).c_str() : "undecided",
+              stream.reason().c_str(), u(sc.refused), u(sc.other_family), u(sc.info_packets));
   if (const sync::Synchronizer* sy = fusion_.synchronizer()) {
     const auto& ac = sy->assembler().counters();
     const auto& fc = fusion_.counts();
@@ -409,19 +436,41 @@ void Session::heard(safety::Sensor s, Stamp t) {
   health_.sample(kind_of(s), t);
 }
 
-void Session::on_datagram(const io::UdpDatagram& d) {
+void Session::on_datagram(lidar3d::Channel channel, const io::UdpDatagram& d) {
   const alloc::Scope frame_path(alloc::Path::Frame);
-  stage_.sensor_data(safety::Sensor::Lidar, d.host_time);
-  if (d.payload.size() != velodyne::kDataPacketSize) {
-    if (bad_length_++ == 0) log_->warn("3D LiDAR: a {}-byte datagram is not a data packet (counted)", d.payload.size());
-    return;
+  const lidar3d::Stream& stream = fusion_.stream();
+  const auto before = stream.counters().rotations();
+  const lidar3d::Outcome outcome = fusion_.lidar(channel, d.payload, d.host_time, jobs_);
+  switch (outcome) {
+    case lidar3d::Outcome::Data:
+      // Only data of the sensor in use keeps it alive: another sensor's packets, or a DIFOP alone, do not.
+      stage_.sensor_data(safety::Sensor::Lidar, d.host_time);
+      if (!model_logged_ && stream.model()) {
+        model_logged_ = true;
+        log_->info("3D LiDAR: {} ({})", lidar3d::to_string(*stream.model()), stream.reason());
+      }
+      break;
+    case lidar3d::Outcome::BadLength:
+      if (bad_length_++ == 0) {
+        log_->warn("3D LiDAR: a {}-byte datagram is not a packet of its port (counted)", d.payload.size());
+      }
+      break;
+    case lidar3d::Outcome::Refused:
+      if (refused_++ == 0 && stream.refused_as()) {
+        const lidar3d::MsopIdentity& id = *stream.refused_as();
+        log_->error("3D LiDAR: MSOP packets of {} ({}): only the RS-LiDAR-32 is supported; refused (counted)",
+                    id.name.empty() ? "an unknown sensor" : "an " + id.name, id.detail);
+      }
+      break;
+    case lidar3d::Outcome::OtherFamily:
+      if (other_family_++ == 0) {
+        log_->warn("3D LiDAR: packets of another sensor family than the {} in use (counted and dropped)",
+                   stream.model() ? lidar3d::to_string(*stream.model()) : "one");
+      }
+      break;
+    default: break;
   }
-  const auto rotations = [this] {
-    return fusion_.stream().counters().full_rotations + fusion_.stream().counters().partial_rotations;
-  };
-  const auto before = rotations();
-  fusion_.lidar(d.payload, d.host_time, jobs_);
-  if (rotations() != before) health_.sample(sync::SensorKind::Lidar3d, d.host_time);
+  if (stream.counters().rotations() != before) health_.sample(sync::SensorKind::Lidar3d, d.host_time);
   submit_jobs();
 }
 

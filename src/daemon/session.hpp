@@ -77,8 +77,9 @@ class Session {
   void print_summary() const;
 
   [[nodiscard]] const Config& config() const { return cfg_; }
-  // The port the 3D LiDAR's datagrams are read on (lidar.data_port, or the one the kernel chose for 0).
-  [[nodiscard]] std::uint16_t lidar_port() const;
+  // The port a channel of the 3D LiDAR is read on (lidar.data_port, msop_port, difop_port, or the one the kernel
+  // chose for 0); 0 when the configured model does not listen on it.
+  [[nodiscard]] std::uint16_t lidar_port(lidar3d::Channel channel = lidar3d::Channel::VelodyneData) const;
   [[nodiscard]] const LiveStageCounts& counts() const { return stage_.counts(); }
 
  private:
@@ -98,7 +99,7 @@ class Session {
   // Each sensor's state and rate, for the live view's page and the status line's faults.
   [[nodiscard]] std::vector<ViewSensor> view_sensors(Stamp now) const;
 
-  void on_datagram(const io::UdpDatagram& d);
+  void on_datagram(lidar3d::Channel channel, const io::UdpDatagram& d);
   // Implausible GNSS / AHRS samples decoded since the last decision go to the next one.
   void pass_problems();
   void submit_jobs();
@@ -118,7 +119,7 @@ class Session {
   DetectorSet detectors_;
   std::shared_ptr<Waker> waker_ = std::make_shared<Waker>();
   Pool pool_;
-  std::unique_ptr<io::UdpReceiver> udp_;
+  std::array<std::unique_ptr<io::UdpReceiver>, 3> udp_;  // by lidar3d::Channel
   std::unique_ptr<io::ScipSource> scip_;
   std::unique_ptr<io::CanReader> can_in_;
   std::uint64_t speed_errors_ = 0;
@@ -135,6 +136,9 @@ class Session {
   std::uint64_t timed_count_ = 0;                                       // rotations delivered
   std::uint64_t lost_ = 0;                                              // rotations dropped, refused or failed
   std::uint64_t bad_length_ = 0;
+  std::uint64_t refused_ = 0;       // MSOP of other RoboSense models
+  std::uint64_t other_family_ = 0;  // packets of the LiDAR family not in use
+  bool model_logged_ = false;       // the line saying which 3D LiDAR it is and why
   bool heard_all_ = false;
   bool stalled_ = false;
   LatencyStats latency_;  // per frame: last packet's kernel receive time to its stop request's write

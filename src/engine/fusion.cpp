@@ -8,9 +8,9 @@
 #include <utility>
 #include <variant>
 
+#include "fieldguard/drivers/lidar3d_stream.hpp"
 #include "fieldguard/drivers/nmea_stream.hpp"
 #include "fieldguard/drivers/scip_session.hpp"
-#include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/drivers/xsens_stream.hpp"
 #include "fieldguard/engine/samples.hpp"
 #include "fieldguard/sync/synchronizer.hpp"
@@ -163,7 +163,7 @@ SensorFusion::SensorFusion(const Config& cfg, FusionInputs inputs)
     : inputs_(inputs),
       gnss_check_(cfg.safety.gnss),
       ahrs_check_(cfg.safety.ahrs),
-      stream_(std::make_unique<velodyne::Stream>(velodyne_stream_options(cfg.lidar))),
+      stream_(std::make_unique<lidar3d::Stream>(lidar3d_stream_options(cfg.lidar))),
       dec_(std::make_unique<Decoders>(cfg)) {
   if (inputs_.any()) sync_ = std::make_unique<sync::Synchronizer>(sync_params(cfg, inputs_));
 }
@@ -219,9 +219,11 @@ void SensorFusion::jobs_from_frames(Stamp host, std::vector<FrameJob>& out) {
   frames_.clear();
 }
 
-void SensorFusion::lidar(ByteSpan payload, Stamp host, std::vector<FrameJob>& out) {
-  stream_->push(payload, host, rotations_);
+lidar3d::Outcome SensorFusion::lidar(lidar3d::Channel channel, ByteSpan payload, Stamp host,
+                                     std::vector<FrameJob>& out) {
+  const lidar3d::Outcome o = stream_->push(channel, payload, host, rotations_);
   if (!rotations_.empty()) rotations_to(host, out);
+  return o;
 }
 
 void SensorFusion::scan2d_bytes(ByteSpan bytes, bool to_sensor, Stamp host, std::vector<FrameJob>& out) {

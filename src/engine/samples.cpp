@@ -1,5 +1,6 @@
 #include "fieldguard/engine/samples.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -46,24 +47,32 @@ scip::ClientConfig scip_client_config(const Scan2dConfig& c) {
   return cc;
 }
 
-velodyne::StreamOptions velodyne_stream_options(const LidarConfig& c) {
-  velodyne::StreamOptions so;
-  so.model = c.model;
-  if (c.has_calibration) so.calibration = c.calibration;
-  so.timestamp_reference = c.timestamp_reference;
-  so.min_range_m = c.min_range_m;
-  so.max_range_m = c.max_range_m;
-  so.rotation_cut_deg = c.rotation_cut_deg;
-  return so;
+lidar3d::StreamOptions lidar3d_stream_options(const LidarConfig& c) {
+  lidar3d::StreamOptions o;
+  o.model = c.model;
+  o.ports = {c.data_port, c.msop_port, c.difop_port};
+  velodyne::StreamOptions& v = o.velodyne;
+  if (c.has_calibration) v.calibration = c.calibration;
+  v.timestamp_reference = c.timestamp_reference;
+  v.min_range_m = c.min_range_m;
+  v.max_range_m = c.max_range_m;
+  v.rotation_cut_deg = c.rotation_cut_deg;
+  robosense::StreamOptions& r = o.robosense;
+  r.decoder.calibration = c.rs32_calibration;
+  r.decoder.nominal_until_difop = true;
+  r.decoder.min_range_m = std::max(c.min_range_m, robosense::DecoderOptions{}.min_range_m);
+  r.decoder.max_range_m = c.max_range_m;
+  r.rotation_cut_deg = c.rotation_cut_deg;
+  return o;
 }
 
 struct SampleDecoder::Impl {
   Impl(const Config& c, std::ostream* o)
-      : config(c), out(o), stream(velodyne_stream_options(c.lidar)), session(scip_client_config(c.scan2d)) {}
+      : config(c), out(o), stream(lidar3d_stream_options(c.lidar)), session(scip_client_config(c.scan2d)) {}
 
   Config config;
   std::ostream* out;
-  velodyne::Stream stream;
+  lidar3d::Stream stream;
   scip::Session session;
   nmea::StreamParser nmea_parser;
   xsens::StreamParser xsens_parser;
@@ -131,15 +140,16 @@ SampleDecoder::SampleDecoder(const Config& config, std::ostream* out) : impl_(st
 SampleDecoder::~SampleDecoder() = default;
 
 void SampleDecoder::lidar(const io::UdpDatagram& d) {
-  if (d.dst_port == impl_->config.lidar.data_port && d.payload.size() == velodyne::kDataPacketSize) {
-    impl_->stream.push(d.payload, d.host_time, impl_->frames);
-    impl_->emit_frames();
-  } else if (d.dst_port == impl_->config.lidar.position_port) {
+  if (d.dst_port == impl_->config.lidar.position_port) {
     auto p = velodyne::decode_position_packet(d.payload);
     if (!p) return;
     ++impl_->counts.lidar_positions;
     impl_->line("{\"sensor\":\"lidar_position\",\"timestamp_us\":" + std::to_string(p->timestamp_us) + ",\"pps\":\"" +
                 std::string(velodyne::to_string(p->pps)) + "\",\"rmc\":" + (p->rmc ? "true" : "false") + "}");
+  } else if (const auto channel = impl_->stream.channel_of(d.dst_port)) {
+    if (impl_->stream.push(*channel, d.payload, d.host_time, impl_->frames) == lidar3d::Outcome::Data) {
+      impl_->emit_frames();
+    }
   }
 }
 

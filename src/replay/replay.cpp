@@ -22,6 +22,7 @@
 
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/core/exit_code.hpp"
+#include "fieldguard/drivers/lidar3d_stream.hpp"
 #include "fieldguard/drivers/velodyne_position.hpp"
 #include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/engine/can_stage.hpp"
@@ -58,7 +59,6 @@ struct PositionCounters {
 };
 
 struct PortCounters {
-  std::uint64_t data_bad_length = 0;
   std::uint64_t other_port = 0;
 };
 
@@ -76,10 +76,10 @@ void print_stage_times(const std::vector<perception::StageTimes>& times) {
   std::printf("  pipeline time     %s\n", stage_times_line(times).c_str());
 }
 
-void print_summary(const std::string& pcap, const io::PcapStats& ps, const velodyne::Stream& stream,
+void print_summary(const std::string& pcap, const io::PcapStats& ps, const lidar3d::Stream& stream,
                    const PositionCounters& pos, const PortCounters& ports, std::uint64_t written, double wall_s,
                    double span_s) {
-  const auto& c = stream.counters();
+  const lidar3d::Counters c = stream.counters();
   std::printf("replay summary: %s\n", pcap.c_str());
   std::printf("  records read      %llu\n", static_cast<unsigned long long>(ps.records));
   std::printf("  udp datagrams     %llu\n", static_cast<unsigned long long>(ps.datagrams));
@@ -87,8 +87,16 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
     std::printf("  ip length repaired %llu (IP total length past the frame; UDP length used)\n",
                 static_cast<unsigned long long>(ps.ip_length_repaired));
   }
-  std::printf("  data packets      %llu read, %llu decoded\n", static_cast<unsigned long long>(c.packets),
+  std::printf("  data packets      %llu read, %llu decoded\n", static_cast<unsigned long long>(c.data_packets),
               static_cast<unsigned long long>(c.decoded));
+  if (stream.family() == lidar3d::Family::RoboSense || c.info_packets != 0) {
+    const robosense::StreamCounters& rc = stream.robosense().counters();
+    std::printf("  difop packets     %llu read, %llu decoded; angles from %s\n",
+                static_cast<unsigned long long>(rc.difop_packets), static_cast<unsigned long long>(rc.difop_accepted),
+                stream.robosense().decoder().nominal() ? "the nominal table (no DIFOP had them)"
+                : rc.difop_accepted != 0               ? "DIFOP"
+                                                       : "the configured table");
+  }
   std::printf("  position packets  %llu read, %llu decoded, %llu with RMC\n",
               static_cast<unsigned long long>(pos.packets), static_cast<unsigned long long>(pos.decoded),
               static_cast<unsigned long long>(pos.rmc));
@@ -98,9 +106,14 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
     std::printf("\n");
   }
   const auto m = stream.model();
-  std::printf("  model             %s", m ? std::string(velodyne::to_string(*m)).c_str() : "undecided");
-  if (!stream.detector().reason().empty()) std::printf(" (stream: %s)", stream.detector().reason().c_str());
+  std::printf("  model             %s", m ? std::string(lidar3d::to_string(*m)).c_str() : "undecided");
+  if (!stream.reason().empty()) std::printf(" (stream: %s)", stream.reason().c_str());
   std::printf("\n");
+  if (const auto& id = stream.refused_as()) {
+    std::printf("  refused           %llu MSOP packets of %s (%s): only the RS-LiDAR-32 is supported\n",
+                static_cast<unsigned long long>(c.refused), id->name.empty() ? "an unknown sensor" : id->name.c_str(),
+                id->detail.c_str());
+  }
 
   std::uint64_t dropped = 0;
   std::string reasons;
@@ -112,11 +125,20 @@ void print_summary(const std::string& pcap, const io::PcapStats& ps, const velod
   for (std::size_t i = 0; i < io::kFrameDropCount; ++i)
     add(std::string(io::to_string(static_cast<io::FrameDrop>(i))), ps.drops[i]);
   add("other_port", ports.other_port);
-  add("data_bad_length", ports.data_bad_length);
+  add("data_bad_length", c.bad_length);
+  add("other_lidar_family", c.other_family);
+  add("msop_refused", c.refused);
   add("position_bad_length", pos.bad_length);
   add("position_nmea_rejected", pos.nmea_rejected);
+  const velodyne::StreamCounters& vc = stream.velodyne().counters();
   for (std::size_t i = 0; i < velodyne::kDecodeErrorCount; ++i) {
-    add("data_" + std::string(velodyne::to_string(static_cast<velodyne::DecodeError>(i))), c.errors[i]);
+    add("data_" + std::string(velodyne::to_string(static_cast<velodyne::DecodeError>(i))), vc.errors[i]);
+  }
+  const robosense::StreamCounters& rc = stream.robosense().counters();
+  for (std::size_t i = 0; i < robosense::kDecodeErrorCount; ++i) {
+    const std::string name(robosense::to_string(static_cast<robosense::DecodeError>(i)));
+    add("msop_" + name, rc.msop_errors[i]);
+    add("difop_" + name, rc.difop_errors[i]);
   }
   std::printf("  dropped           %llu\n%s", static_cast<unsigned long long>(dropped), reasons.c_str());
   if (ps.truncated) std::printf("  file truncated    yes: the capture ends inside a record\n");
@@ -442,12 +464,8 @@ void Replay::submit_jobs() {
 
 void Replay::on_datagram(const io::UdpDatagram& dg) {
   if (samples_) samples_->lidar(dg);
-  if (dg.dst_port == cfg_.lidar.data_port) {
-    if (dg.payload.size() != velodyne::kDataPacketSize) {
-      ++ports_.data_bad_length;
-      return;
-    }
-    fusion_->lidar(dg.payload, dg.host_time, jobs_);
+  if (const auto channel = fusion_->stream().channel_of(dg.dst_port)) {
+    fusion_->lidar(*channel, dg.payload, dg.host_time, jobs_);
     submit_jobs();
   } else if (dg.dst_port == cfg_.lidar.position_port) {
     ++pos_.packets;
@@ -562,7 +580,8 @@ void Replay::print_fusion_summary() const {
 }
 
 int Replay::finish() {
-  const velodyne::Stream& stream = fusion_->stream();
+  const lidar3d::Stream& stream = fusion_->stream();
+  const lidar3d::Counters counts = stream.counters();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
   const io::PcapStats& pcap_stats = recording_->capture().stats();
   print_summary(pcap_path_, pcap_stats, stream, pos_, ports_, written_, wall_s,
@@ -608,27 +627,45 @@ int Replay::finish() {
   if (pcap_stats.truncated)
     log_->warn("{} is truncated: it ends inside a record; everything before was used", pcap_path_);
   if (!pcap_stats.read_error.empty()) log_->warn("{}: reading stopped early: {}", pcap_path_, pcap_stats.read_error);
-  if (cfg_.lidar.model != velodyne::Model::Unknown && stream.detector().decided() &&
-      *stream.detector().decided() != cfg_.lidar.model) {
+  const auto& detected = stream.velodyne().detector().decided();
+  if (cfg_.lidar.model != lidar3d::Model::Auto && stream.family() == lidar3d::Family::Velodyne && detected &&
+      std::string_view(velodyne::to_string(*detected)) != lidar3d::to_string(cfg_.lidar.model)) {
     log_->warn("lidar.model is {} but the packets look like a {} ({}); check the configuration",
-               velodyne::to_string(cfg_.lidar.model), velodyne::to_string(*stream.detector().decided()),
-               stream.detector().reason());
+               lidar3d::to_string(cfg_.lidar.model), velodyne::to_string(*detected),
+               stream.velodyne().detector().reason());
+  }
+  if (counts.other_family != 0) {
+    log_->warn(
+        "{} packets of another 3D LiDAR family than the {} in use were dropped; check lidar.model and the "
+        "ports",
+        counts.other_family, stream.model() ? lidar3d::to_string(*stream.model()) : "one");
   }
   if (!write_error_.empty()) {
     std::fprintf(stderr, "fieldguard replay: %s\n", write_error_.c_str());
     return kExitFailure;
   }
-  if (!logs_.empty() && stream.counters().packets == 0) return kExitOk;  // a recording without 3D LiDAR data
-  if (stream.counters().packets == 0) {
+  if (!logs_.empty() && counts.data_packets == 0 && counts.refused == 0) return kExitOk;  // no 3D LiDAR data
+  if (counts.data_packets == 0 && counts.refused != 0) {
+    const lidar3d::MsopIdentity& id = *stream.refused_as();
     std::fprintf(stderr,
-                 "fieldguard replay: %s holds no UDP datagram to the data port %u: not a Velodyne capture, or "
-                 "lidar.data_port is wrong\n",
-                 pcap_path_.c_str(), cfg_.lidar.data_port);
+                 "fieldguard replay: %s holds MSOP packets of %s (%s), not of an RS-LiDAR-32: fieldguard decodes the "
+                 "HDL-32E, VLP-16 and RS-32 only\n",
+                 pcap_path_.c_str(), id.name.empty() ? "an unknown sensor" : id.name.c_str(), id.detail.c_str());
     return kExitBadInput;
   }
-  if (stream.counters().decoded == 0) {
-    std::fprintf(stderr, "fieldguard replay: none of the %llu datagrams to port %u in %s is a Velodyne data packet\n",
-                 static_cast<unsigned long long>(stream.counters().packets), cfg_.lidar.data_port, pcap_path_.c_str());
+  if (counts.data_packets == 0) {
+    std::fprintf(stderr,
+                 "fieldguard replay: %s holds no UDP datagram to the data port %u (Velodyne) or the MSOP port %u "
+                 "(RS-32): not a 3D LiDAR capture, or lidar.data_port / lidar.msop_port is wrong\n",
+                 pcap_path_.c_str(), cfg_.lidar.data_port, cfg_.lidar.msop_port);
+    return kExitBadInput;
+  }
+  if (counts.decoded == 0) {
+    const bool rs32 = stream.family() == lidar3d::Family::RoboSense;
+    std::fprintf(stderr, "fieldguard replay: none of the %llu datagrams to port %u in %s is a%s\n",
+                 static_cast<unsigned long long>(counts.data_packets),
+                 rs32 ? cfg_.lidar.msop_port : cfg_.lidar.data_port, pcap_path_.c_str(),
+                 rs32 ? "n RS-32 MSOP packet" : " Velodyne data packet");
     return kExitBadInput;
   }
   return kExitOk;

@@ -46,7 +46,7 @@ TEST(ConfigFiles, PublishedReproducesThePublishedPipeline) {
   EXPECT_EQ(p.filters.max_points, 240);
   EXPECT_DOUBLE_EQ(p.filters.min_volume_m3, 0.06);
   EXPECT_DOUBLE_EQ(p.filters.max_volume_m3, 1.2);
-  EXPECT_EQ(r.config.lidar.model, velodyne::Model::HDL32E);
+  EXPECT_EQ(r.config.lidar.model, lidar3d::Model::HDL32E);
   // Nothing of ours is switched on.
   EXPECT_DOUBLE_EQ(p.voxel.coarse_from_m, 0.0);
   EXPECT_EQ(p.cluster.method, perception::ClusterMethod::Fixed);
@@ -330,6 +330,8 @@ lidar:
   model: VLP-16
   data_port: 2369
   position_port: 8309
+  msop_port: 6700
+  difop_port: 7789
   timestamp_reference: first_firing
   min_range_m: 1.0
   max_range_m: 90
@@ -339,9 +341,11 @@ lidar:
                                   "t.yaml");
   ASSERT_TRUE(r.ok()) << dump(r);
   const auto& l = r.config.lidar;
-  EXPECT_EQ(l.model, velodyne::Model::VLP16);
+  EXPECT_EQ(l.model, lidar3d::Model::VLP16);
   EXPECT_EQ(l.data_port, 2369);
   EXPECT_EQ(l.position_port, 8309);
+  EXPECT_EQ(l.msop_port, 6700);
+  EXPECT_EQ(l.difop_port, 7789);
   EXPECT_EQ(l.timestamp_reference, velodyne::TimestampReference::FirstFiring);
   EXPECT_DOUBLE_EQ(l.min_range_m, 1.0);
   EXPECT_DOUBLE_EQ(l.max_range_m, 90.0);
@@ -370,7 +374,7 @@ TEST(ConfigLoad, ReportsEveryProblemAtOnceWithLineAndKey) {
       "    max_points: 240\n"                // 15 min > max
       "  cluster: {tolerance_m: [1, 2]}\n";  // 16 a list where a number belongs
   const auto r = load_config_text(text, "bad.yaml");
-  EXPECT_TRUE(has_issue(r, "lidar.model", "not one of auto, HDL-32E, VLP-16", 2)) << dump(r);
+  EXPECT_TRUE(has_issue(r, "lidar.model", "not one of auto, HDL-32E, VLP-16, RS-32", 2)) << dump(r);
   EXPECT_TRUE(has_issue(r, "lidar.data_port", "out of range", 3)) << dump(r);
   EXPECT_TRUE(has_issue(r, "lidar.min_range_m", "expected a number", 4)) << dump(r);
   EXPECT_TRUE(has_issue(r, "lidar.colour", "unknown key", 5)) << dump(r);
@@ -499,6 +503,36 @@ TEST(ConfigLoad, CalibrationFileRelativeToTheConfigAndCheckedAgainstTheModel) {
   EXPECT_EQ(good.config.lidar.calibration.model, velodyne::Model::HDL32E);
   const auto bad = load_config_file((dir / "mismatch.yaml").string());
   EXPECT_TRUE(has_issue(bad, "lidar.calibration_file", "HDL-32E calibration but lidar.model is VLP-16")) << dump(bad);
+  fs::remove_all(dir);
+}
+
+// An RS-32's angle.csv: read with lidar.model RS-32 (it wins over DIFOP's table); refused for auto, which cannot
+// know the table fits the sensor it finds; a malformed one names its line.
+TEST(ConfigLoad, Rs32AngleTableNeedsTheModelAndNamesItsBadLine) {
+  const fs::path dir = fs::temp_directory_path() / "fieldguard_config_rs32_test";
+  fs::create_directories(dir);
+  {
+    std::ofstream csv(dir / "angle.csv");
+    for (int c = 0; c < 32; ++c) csv << (-25.0 + 1.25 * c) << "," << (c % 2 == 0 ? 0.2 : -0.2) << "\n";
+    std::ofstream bad(dir / "bad.csv");
+    for (int c = 0; c < 32; ++c) bad << (c == 7 ? "ten" : "1.5") << ",0\n";
+    std::ofstream(dir / "good.yaml") << "lidar: {model: RS-32, calibration_file: angle.csv}\n";
+    std::ofstream(dir / "auto.yaml") << "lidar: {model: auto, calibration_file: angle.csv}\n";
+    std::ofstream(dir / "bad.yaml") << "lidar: {model: RS-32, calibration_file: bad.csv}\n";
+    std::ofstream(dir / "ports.yaml") << "lidar: {msop_port: 2368}\n";
+  }
+  const auto good = load_config_file((dir / "good.yaml").string());
+  ASSERT_TRUE(good.ok()) << dump(good);
+  ASSERT_TRUE(good.config.lidar.rs32_calibration.has_value());
+  EXPECT_DOUBLE_EQ(good.config.lidar.rs32_calibration->vert_deg[31], -25.0 + 1.25 * 31);
+  EXPECT_DOUBLE_EQ(good.config.lidar.rs32_calibration->horiz_deg[1], -0.2);
+  EXPECT_FALSE(good.config.lidar.has_calibration);
+  const auto for_auto = load_config_file((dir / "auto.yaml").string());
+  EXPECT_TRUE(has_issue(for_auto, "lidar.calibration_file", "it needs lidar.model: RS-32")) << dump(for_auto);
+  const auto bad = load_config_file((dir / "bad.yaml").string());
+  EXPECT_TRUE(has_issue(bad, "lidar.calibration_file", "angle.csv line 8: 'ten' is not an angle")) << dump(bad);
+  const auto ports = load_config_file((dir / "ports.yaml").string());
+  EXPECT_TRUE(has_issue(ports, "lidar.msop_port", "is the same as lidar.data_port")) << dump(ports);
   fs::remove_all(dir);
 }
 

@@ -72,7 +72,7 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   const std::uint16_t position_port = free_udp_port();
   const std::string config = (dir.path() / "live.yaml").string();
   std::ofstream(config) << "lidar: {model: auto, data_port: " << data_port << ", position_port: " << position_port
-                        << "}\n"
+                        << ", msop_port: " << free_udp_port() << ", difop_port: " << free_udp_port() << "}\n"
                         << "scan2d: {enabled: true, host: 127.0.0.1, port: " << scip_port << "}\n"
                         << "gnss: {enabled: true, device: " << gnss_dev << ", baud: 115200}\n"
                         << "ahrs: {enabled: true, device: " << ahrs_dev << ", baud: 921600}\n";

@@ -123,9 +123,8 @@ class ReplayFusion : public ::testing::Test {
     while (auto ev = rec->next()) {
       last = ev->time;
       if (ev->datagram != nullptr) {
-        if (ev->datagram->dst_port == config_->lidar.data_port &&
-            ev->datagram->payload.size() == velodyne::kDataPacketSize) {
-          fusion.lidar(ev->datagram->payload, ev->time, jobs);
+        if (const auto channel = fusion.stream().channel_of(ev->datagram->dst_port)) {
+          fusion.lidar(*channel, ev->datagram->payload, ev->time, jobs);
         }
       } else if (ev->kind == LogKind::Scan2d) {
         fusion.scan2d_bytes(ev->record->bytes, ev->record->direction == io::Direction::ToSensor, ev->time, jobs);

@@ -138,6 +138,9 @@ class RunE2e : public ::testing::Test {
       if (at != std::string::npos) text.replace(at, from.size(), to);
     };
     replace("data_port: 2368 ", "data_port: " + std::to_string(port) + " ");
+    // model auto listens on the RS-32's ports too: free ones, for tests running side by side.
+    replace("msop_port: 6699 ", "msop_port: " + std::to_string(free_udp_port()) + " ");
+    replace("difop_port: 7788 ", "difop_port: " + std::to_string(free_udp_port()) + " ");
     replace("\n  sink: socketcan ", "\n  sink: candump ");
     replace("\n  log_path: \"\" ", "\n  log_path: '" + log.string() + "' ");
     replace("\n    half_width_m: 2.0 ", "\n    half_width_m: 0.3 ");

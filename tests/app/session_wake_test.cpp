@@ -35,7 +35,9 @@ class RecordingSink final : public output::CanSink {
 
 TEST(SessionWake, AFinishedFrameIsDecidedWithoutAnyTimer) {
   Config cfg;
-  cfg.lidar.data_port = 0;  // the kernel chooses
+  cfg.lidar.data_port = 0;  // the kernel chooses (for the RS-32's ports too: model auto listens on them)
+  cfg.lidar.msop_port = 0;
+  cfg.lidar.difop_port = 0;
   cfg.pipeline.workers = 2;
   boost::asio::io_context io;
   cfg.can.j1939.address_claim = false;  // the STOP of start-up at once, not after the claim's 250 ms

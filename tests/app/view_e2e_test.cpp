@@ -49,6 +49,9 @@ const std::string kNode = kSource + "/tests/interop/node/";
 fs::path write_config(const fs::path& dir, std::uint16_t port, const std::string& half_width = "2.0") {
   std::string text = slurp(kSource + "/config/fieldguard.yaml");
   text = replaced(text, "data_port: 2368 ", "data_port: " + std::to_string(port) + " ");
+  // model auto listens on the RS-32's ports too: free ones, for tests running side by side.
+  text = replaced(text, "msop_port: 6699 ", "msop_port: " + std::to_string(testing::free_udp_port()) + " ");
+  text = replaced(text, "difop_port: 7788 ", "difop_port: " + std::to_string(testing::free_udp_port()) + " ");
   text = replaced(text, "\n  sink: socketcan ", "\n  sink: none ");
   text = replaced(text, "\n    half_width_m: 2.0 ", "\n    half_width_m: " + half_width + " ");
   text = replaced(text, "\n    enabled: false               # true | false", "\n    enabled: true");

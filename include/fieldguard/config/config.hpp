@@ -3,12 +3,15 @@
 // their typed structs; they never see the parse tree.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "fieldguard/config/config_fusion.hpp"
 #include "fieldguard/config/config_output.hpp"
 #include "fieldguard/core/mounting.hpp"
+#include "fieldguard/drivers/lidar3d_stream.hpp"
+#include "fieldguard/drivers/robosense.hpp"
 #include "fieldguard/drivers/velodyne_calibration.hpp"
 #include "fieldguard/drivers/velodyne_decoder.hpp"
 #include "fieldguard/output/safety_params.hpp"
@@ -17,19 +20,24 @@
 namespace fieldguard::app {
 
 struct LidarConfig {
-  velodyne::Model model = velodyne::Model::Unknown;  // Unknown = detect from the stream ("auto")
-  std::string calibration_file;                      // "" = built-in table; .yaml (ROS) or .xml (VeloView)
-  std::uint16_t data_port = 2368;
-  std::uint16_t position_port = 8308;
+  lidar3d::Model model = lidar3d::Model::Auto;  // Auto = from the datagrams
+  // "" = built-in table (Velodyne), DIFOP's (RS-32); .yaml (ROS) or .xml (VeloView) for a Velodyne, the unit's
+  // angle.csv for an RS-32.
+  std::string calibration_file;
+  std::uint16_t data_port = 2368;      // Velodyne data packets
+  std::uint16_t position_port = 8308;  // Velodyne position packets
+  std::uint16_t msop_port = 6699;      // RS-32 MSOP (points)
+  std::uint16_t difop_port = 7788;     // RS-32 DIFOP (device info: angles, return mode)
   velodyne::TimestampReference timestamp_reference = velodyne::TimestampReference::LastFiring;
   double min_range_m = 0.5;
   double max_range_m = 130.0;
   double rotation_cut_deg = 0.0;
   Mounting mounting;
 
-  // Filled by the loader when calibration_file is set and readable.
+  // Filled by the loader when calibration_file is set and readable: a Velodyne table, or an RS-32 one.
   velodyne::Calibration calibration;
   bool has_calibration = false;
+  std::optional<robosense::Calibration> rs32_calibration;
 };
 
 // Hokuyo UTM-30LX-EW over SCIP 2.0 (TCP): covers the near blind zone in front of the 3D LiDAR.

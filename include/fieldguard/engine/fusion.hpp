@@ -32,9 +32,11 @@
 #include "fieldguard/perception/pipeline.hpp"
 #include "fieldguard/sync/synced_frame.hpp"
 
-namespace fieldguard::velodyne {
+namespace fieldguard::lidar3d {
 class Stream;
-}
+enum class Outcome : std::uint8_t;
+enum class Channel : std::uint8_t;
+}  // namespace fieldguard::lidar3d
 namespace fieldguard::sync {
 class Synchronizer;
 }
@@ -161,8 +163,8 @@ class SensorFusion {
 
   [[nodiscard]] bool fused() const { return inputs_.any(); }
 
-  // A 3D LiDAR data packet (kDataPacketSize bytes) received at `host`.
-  void lidar(ByteSpan payload, Stamp host, std::vector<FrameJob>& out);
+  // A datagram of one of the 3D LiDAR's channels (lidar3d::Stream::push()) received at `host`.
+  lidar3d::Outcome lidar(lidar3d::Channel channel, ByteSpan payload, Stamp host, std::vector<FrameJob>& out);
   // The 2D LiDAR's conversation as a byte log holds it (to_sensor: what the client sent; a new connection
   // starts with SCIP2.0) ...
   void scan2d_bytes(ByteSpan bytes, bool to_sensor, Stamp host, std::vector<FrameJob>& out);
@@ -181,7 +183,7 @@ class SensorFusion {
   // now and then (the daemon: every second). Returns how many.
   std::size_t trim_spares();
 
-  [[nodiscard]] const velodyne::Stream& stream() const { return *stream_; }
+  [[nodiscard]] const lidar3d::Stream& stream() const { return *stream_; }
   [[nodiscard]] const sync::Synchronizer* synchronizer() const { return sync_.get(); }
   [[nodiscard]] const FusionCounts& counts() const { return counts_; }
 
@@ -211,7 +213,7 @@ class SensorFusion {
   output::safety::GnssCheck gnss_check_;
   output::safety::AhrsCheck ahrs_check_;
   Problems problems_;
-  std::unique_ptr<velodyne::Stream> stream_;
+  std::unique_ptr<lidar3d::Stream> stream_;
   std::unique_ptr<sync::Synchronizer> sync_;
   std::unique_ptr<Decoders> dec_;
   std::vector<LidarFrame> rotations_;

@@ -10,14 +10,15 @@
 
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/core/bytes.hpp"
+#include "fieldguard/drivers/lidar3d_stream.hpp"
 #include "fieldguard/drivers/scip_client.hpp"
-#include "fieldguard/drivers/velodyne_stream.hpp"
 #include "fieldguard/io/udp_frame.hpp"
 
 namespace fieldguard::app {
 
-// The Velodyne stream as the configuration describes it (replay and the sample decoder build the same one).
-[[nodiscard]] velodyne::StreamOptions velodyne_stream_options(const LidarConfig& lidar);
+// The 3D LiDAR's stream as the configuration describes it (replay, the daemon and the sample decoder build the
+// same one). An RS-32 decodes with nominal angles until its first DIFOP.
+[[nodiscard]] lidar3d::StreamOptions lidar3d_stream_options(const LidarConfig& lidar);
 // The SCIP client a recording's conversation was held with (replay re-plays it into a scip::Session).
 [[nodiscard]] scip::ClientConfig scip_client_config(const Scan2dConfig& c);
 
