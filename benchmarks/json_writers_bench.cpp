@@ -229,6 +229,7 @@ Json truth_json_nlohmann(const sim::FrameTruth& t) {
   return {{"frame", t.frame},
           {"stamp", static_cast<double>(us) / 1e6},  // exact microseconds: the double nearest to them
           {"period_s", fixed(t.period_s, 6)},
+          {"sensor", std::string(t.sensor)},
           {"roll_deg", fixed(t.roll_deg, 3)},
           {"pitch_deg", fixed(t.pitch_deg, 3)},
           {"sensor_world",

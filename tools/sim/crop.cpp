@@ -42,9 +42,10 @@ double CropBlock::canopy_height(double x, double y) const {
   return params_.height_min_m + (params_.height_max_m - params_.height_min_m) * (a + (b - a) * v);
 }
 
-bool CropBlock::intersect(const Ray& ray, const Terrain& terrain, double tmax, Rng& rng, double& t_hit) const {
+bool CropBlock::intersect(const Ray& ray, const Terrain& terrain, double tmin, double tmax, Rng& rng,
+                          double& t_hit) const {
   // Clip the ray to the rectangle in x-y.
-  double ta = 0.0;
+  double ta = tmin;
   double tb = tmax;
   const std::array<double, 2> o{ray.origin.x, ray.origin.y};
   const std::array<double, 2> d{ray.dir.x, ray.dir.y};

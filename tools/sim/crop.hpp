@@ -28,8 +28,9 @@ class CropBlock {
   CropBlock(const CropParams& params, const Terrain& terrain, std::uint64_t seed);
 
   [[nodiscard]] double canopy_height(double x, double y) const;  // above the ground, m
-  // Where the ray stops in the crop, if before tmax. Draws from `rng` only when the ray enters the canopy.
-  [[nodiscard]] bool intersect(const Ray& ray, const Terrain& terrain, double tmax, Rng& rng, double& t_hit) const;
+  // Where the ray stops in the crop, if between tmin and tmax. Draws from `rng` only when the ray enters the canopy.
+  [[nodiscard]] bool intersect(const Ray& ray, const Terrain& terrain, double tmin, double tmax, Rng& rng,
+                               double& t_hit) const;
   [[nodiscard]] const Aabb& bounds() const { return bounds_; }  // world
   [[nodiscard]] const CropParams& params() const { return params_; }
 

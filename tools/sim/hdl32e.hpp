@@ -1,6 +1,7 @@
 #pragma once
-// The simulated sensor: a Velodyne HDL-32E in single (strongest) return mode (protocols.md §1.2-§1.7).
-// Independent of src/drivers on purpose: the encoder and the project's decoder are checked against each other.
+// The Velodyne HDL-32E (protocols.md §1.2-§1.8); the VLP-16 (vlp16.hpp) shares its packet layout, distance unit
+// and factory bytes. Independent of src/drivers on purpose: the simulator's encoders and the project's decoders are
+// checked against each other.
 
 #include <array>
 #include <cstddef>
@@ -19,6 +20,7 @@ inline constexpr std::int64_t kPacketNs = 12 * kBlockNs;  // 552.96 us
 inline constexpr std::int64_t kLastFiringNs = 11 * kBlockNs + 31 * kFiringNs;
 inline constexpr double kDistanceUnitM = 0.002;
 inline constexpr std::uint8_t kReturnStrongest = 0x37;
+inline constexpr std::uint8_t kReturnDual = 0x39;
 inline constexpr std::uint8_t kProductHdl32e = 0x21;
 inline constexpr std::uint16_t kDataPort = 2368;
 

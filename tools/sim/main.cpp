@@ -1,4 +1,5 @@
-// fieldguard-sim: writes an HDL-32E capture (classic pcap) of a simulated scene and its ground truth (JSONL).
+// fieldguard-sim: writes a LiDAR capture (classic pcap: HDL-32E, VLP-16 or RS-LiDAR-32, strongest or dual return) of
+// a simulated scene and its ground truth (JSONL).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,9 +13,9 @@
 #include <vector>
 
 #include "cli/cli.hpp"
-#include "sim/hdl32e.hpp"
 #include "sim/pcap_writer.hpp"
 #include "sim/scenes.hpp"
+#include "sim/sensor.hpp"
 #include "sim/session.hpp"
 #include "sim/simulator.hpp"
 #include "sim/truth_writer.hpp"
@@ -28,14 +29,15 @@ constexpr std::int64_t kDefaultStartS = 1718449170;  // 2024-06-15 10:59:30 UTC:
 
 constexpr const char* kSynopsis =
     "fieldguard-sim --scene NAME (--pcap FILE | --session DIR) [--truth FILE] [--rotations N]\n"
-    "                      [--rate HZ] [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
+    "                      [--sensor hdl32e|vlp16|rs32] [--return strongest|dual] [--rate HZ]\n"
+    "                      [--seed N] [--start-time UNIX_S] [--threads N] [--quiet]\n"
     "                      [--antenna X,Y,Z] [--origin LAT,LON,H] [--heading DEG]\n"
     "       fieldguard-sim --list-scenes | --help";
 
 constexpr const char* kAbout =
-    "Simulates a Velodyne HDL-32E (strongest return, 0x37/0x21, 2 mm units) 0.95 m above a field at the\n"
-    "front of a tractor and writes its data packets as a classic pcap (Ethernet/IPv4/UDP to port 2368,\n"
-    "record time = packet time = its last firing) plus one ground-truth JSON line per rotation.";
+    "Simulates a LiDAR 0.95 m above a field at the front of a tractor (a Velodyne HDL-32E by default) and\n"
+    "writes its packets as a classic pcap (Ethernet/IPv4/UDP, each packet recorded at its last firing)\n"
+    "plus one ground-truth JSON line per rotation.";
 
 // What follows the options: the rotation rule, the scene catalogue (word-wrapped at 100 columns, indented
 // by 6), the truth's layout and the exit codes.
@@ -44,6 +46,19 @@ std::string footer() {
       "Every rotation starts exactly at azimuth 0 (the cut angle) with block 0 of a packet, so each one is a\n"
       "full turn. A reader's rotation assembler may still flag the first and the last rotation of the file\n"
       "as partial (it cannot know the first one began at the cut, and the stream ends after the last).\n\n"
+      "Sensors (--sensor):\n"
+      "  hdl32e  Velodyne HDL-32E: data packets to port 2368, factory bytes 0x37 (strongest) or 0x39 (dual)\n"
+      "          and 0x21, 2 mm units; the timestamp marks the packet's last firing\n"
+      "  vlp16   Velodyne VLP-16: as the HDL-32E, product byte 0x22, 16 lasers fired twice per block\n"
+      "  rs32    RoboSense RS-LiDAR-32: MSOP to port 6699 (0.5 cm units, header time = the packet's first\n"
+      "          firing) and a DIFOP to port 7788 every second, the first before any MSOP (rpm, return mode,\n"
+      "          angles: the example unit of protocols.md 2.4, horizontal corrections +0.3/-0.3 deg\n"
+      "          alternating, so a few firings at the start and end of a rotation lie across the cut);\n"
+      "          returns from 0.4 m\n"
+      "Dual return (--return dual): each firing fills a pair of blocks, so a packet covers half the azimuth.\n"
+      "A ray that stops in foliage or a crop canopy goes on, and what it meets 0.5 m or more behind is a\n"
+      "second echo; one echo fills both blocks. Velodyne pairs: the last echo, then the strongest (or the\n"
+      "second strongest); RS-LiDAR-32 pairs: the strongest, then the other.\n\n"
       "Scenes (default rotations in brackets):\n";
   for (const SceneInfo& s : scene_catalog()) {
     out += "  " + std::string(s.name) + " [" + std::to_string(s.default_rotations) + "]\n";
@@ -69,7 +84,9 @@ struct Options {
   std::string pcap;
   std::string truth;
   std::optional<int> rotations;
-  double rate_hz = 10.0;
+  SensorModel sensor = SensorModel::Hdl32e;
+  ReturnMode returns = ReturnMode::Strongest;
+  std::string rate = "10";  // checked once the sensor is known
   std::uint64_t seed = 1;
   std::int64_t start_s = kDefaultStartS;
   unsigned threads = 1;
@@ -126,10 +143,28 @@ void declare(CLI::App& app, Options& opt) {
       app, "--rotations", opt.rotations, [](int n) { return n >= 1; }, "a whole number >= 1",
       "rotations to simulate (default: the scene's)")
       ->type_name("N");
-  cli::number(app, "--rate", opt.rate_hz, cli::Between<double>{5.0, 20.0},
-              "a number of Hz from 5 to 20 (the HDL-32E's range)",
-              "rotation rate, 5..20 (default 10); rounded to a whole number of packets per\n"
-              "rotation: 10 -> 181 packets (9.991 Hz), 5 -> 362 packets (4.996 Hz)")
+  cli::checked(
+      app, "--sensor", opt.sensor,
+      [](std::string_view s, SensorModel& m) {
+        const auto model = sensor_model(s);
+        if (model) m = *model;
+        return model.has_value();
+      },
+      [](SensorModel /*m*/) { return true; }, "hdl32e, vlp16 or rs32", "the LiDAR (default hdl32e; see Sensors below)")
+      ->type_name("NAME");
+  cli::checked(
+      app, "--return", opt.returns,
+      [](std::string_view s, ReturnMode& m) {
+        const auto mode = return_mode(s);
+        if (mode) m = *mode;
+        return mode.has_value();
+      },
+      [](ReturnMode /*m*/) { return true; }, "strongest or dual", "return mode (default strongest)")
+      ->type_name("MODE");
+  app.add_option("--rate", opt.rate,
+                 "rotation rate (default 10): 5..20 on the Velodynes, 5, 10 or 20 on the\n"
+                 "RS-LiDAR-32; rounded to a whole number of packets per rotation (HDL-32E,\n"
+                 "strongest: 10 -> 181 packets, 9.991 Hz; the summary line gives the real rate)")
       ->type_name("HZ");
   cli::number(
       app, "--seed", opt.seed, [](std::uint64_t /*seed*/) { return true; }, "a whole number >= 0",
@@ -161,6 +196,11 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (opt.scene.empty()) return tool.fail("--scene is required (--list-scenes lists them)");
+  const Sensor sensor = make_sensor(opt.sensor, opt.returns);
+  double rate_hz = 0.0;
+  if (!cli::parse_number(opt.rate, rate_hz) || !sensor.rate_supported(rate_hz)) {
+    return tool.fail("--rate: wants " + sensor.rate_rule() + ", not '" + opt.rate + "'");
+  }
   const SceneInfo* info = find_scene(opt.scene);
   if (info == nullptr) return tool.fail("unknown scene '" + opt.scene + "' (--list-scenes lists them)");
   if (opt.pcap.empty() && !opt.session.empty()) opt.pcap = opt.session + "/lidar.pcap";
@@ -180,7 +220,9 @@ int main(int argc, char** argv) {
   }
 
   SimSettings settings;
-  settings.rate_hz = opt.rate_hz;
+  settings.rate_hz = rate_hz;
+  settings.sensor = opt.sensor;
+  settings.returns = opt.returns;
   settings.seed = opt.seed;
   settings.start_time_ns = opt.start_s * 1000000000LL;
   settings.threads = opt.threads;
@@ -188,7 +230,7 @@ int main(int argc, char** argv) {
   SceneSetup setup;
   setup.seed = opt.seed;
   setup.rotations = rotations;
-  setup.period_s = Simulator::period_for(opt.rate_hz);
+  setup.period_s = Simulator::period_for(rate_hz, opt.sensor, opt.returns);
   const auto start = std::chrono::steady_clock::now();
   Simulator sim(*build_scene(opt.scene, setup), settings);
 
@@ -209,7 +251,7 @@ int main(int argc, char** argv) {
     packets.clear();
     const FrameTruth t = sim.rotation(static_cast<std::uint64_t>(k), packets);
     for (const TimedPacket& p : packets) {
-      if (!pcap.write_udp(p.bytes, p.pcap_time_ns, hdl32e::kDataPort, hdl32e::kDataPort)) {
+      if (!pcap.write_udp(p.bytes, p.pcap_time_ns, p.port, p.port)) {
         std::cerr << "fieldguard-sim: " << pcap.error() << "\n";
         return 1;
       }
@@ -244,9 +286,10 @@ int main(int argc, char** argv) {
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!opt.quiet) {
     std::fprintf(stderr,
-                 "fieldguard-sim: scene %s, seed %llu: %d rotations at %.4f Hz (%d packets each), %llu packets, "
-                 "%.0f points per rotation, %.2f s (%.1f rotations/s)\n  %s\n  %s\n",
-                 opt.scene.c_str(), static_cast<unsigned long long>(opt.seed), rotations, 1.0 / sim.period_s(),
+                 "fieldguard-sim: scene %s, seed %llu, %s %s return: %d rotations at %.4f Hz (%d data packets "
+                 "each), %llu packets, %.0f points per rotation, %.2f s (%.1f rotations/s)\n  %s\n  %s\n",
+                 opt.scene.c_str(), static_cast<unsigned long long>(opt.seed), std::string(sensor.label).c_str(),
+                 std::string(to_string(opt.returns)).c_str(), rotations, 1.0 / sim.period_s(),
                  sim.packets_per_rotation(), static_cast<unsigned long long>(packet_count),
                  static_cast<double>(points) / rotations, secs, rotations / secs, opt.pcap.c_str(), opt.truth.c_str());
     if (!opt.session.empty()) {

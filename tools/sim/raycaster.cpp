@@ -64,11 +64,11 @@ void RayCaster::prepare(Vec3 sensor, double margin_m, std::span<const Aabb> swep
   }
 }
 
-CastHit RayCaster::cast_body(Vec3 dir_sensor) const {
+CastHit RayCaster::cast_body(Vec3 origin_sensor, Vec3 dir_sensor) const {
   CastHit hit;
   double best = scene_.noise.max_range_m;
   Span span;
-  const Ray local{{}, dir_sensor};
+  const Ray local{origin_sensor, dir_sensor};
   for (const Primitive& p : scene_.body) {
     if (intersect(p, local, best, span) && span.t_in > 0.0) {
       best = span.t_in;
@@ -82,7 +82,7 @@ CastHit RayCaster::cast_body(Vec3 dir_sensor) const {
 }
 
 CastHit RayCaster::cast(const SensorPose& pose, Vec3 dir_sensor, const CastHit& body, Rng& rng,
-                        const SceneObject* moving) const {
+                        const SceneObject* moving, double from_m) const {
   CastHit hit = body;
   double best = body.range_m;
   Span span;
@@ -96,11 +96,12 @@ CastHit RayCaster::cast(const SensorPose& pose, Vec3 dir_sensor, const CastHit& 
     hit.cos_incidence = std::abs(dot(scene_.terrain.normal(p.x, p.y), ray.dir));
   }
   for (std::size_t c = 0; c < scene_.crops.size(); ++c) {
-    if (scene_.crops[c].intersect(ray, scene_.terrain, best, rng, t)) {
+    if (scene_.crops[c].intersect(ray, scene_.terrain, from_m, best, rng, t)) {
       best = t;
       hit.target = crop_target(c);
       hit.reflectivity = scene_.crops[c].params().reflectivity;
       hit.cos_incidence = kPorousCosine;
+      hit.porous = true;
     }
   }
   const Vec3 inv{1.0 / ray.dir.x, 1.0 / ray.dir.y, 1.0 / ray.dir.z};
@@ -117,14 +118,16 @@ CastHit RayCaster::cast(const SensorPose& pose, Vec3 dir_sensor, const CastHit& 
     for (const Primitive& p : o.parts) {
       if (!intersect(p, ray, best, span)) continue;
       if (p.mean_free_path_m > 0.0) {
-        const double stop = std::max(span.t_in, 0.0) + rng.exponential(p.mean_free_path_m);
+        const double stop = std::max(span.t_in, from_m) + rng.exponential(p.mean_free_path_m);
         if (stop >= span.t_out || stop >= best) continue;
         best = stop;
         hit.cos_incidence = kPorousCosine;
+        hit.porous = true;
       } else {
-        if (span.t_in <= 1e-6) continue;
+        if (span.t_in <= std::max(1e-6, from_m)) continue;
         best = span.t_in;
         hit.cos_incidence = std::abs(dot(span.normal, ray.dir));
+        hit.porous = false;
       }
       hit.target = static_cast<std::int64_t>(i);
       hit.reflectivity = p.reflectivity;

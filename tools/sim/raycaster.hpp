@@ -20,6 +20,7 @@ struct CastHit {
   std::int64_t target = -1;
   double cos_incidence = 1.0;
   double reflectivity = 0.0;
+  bool porous = false;  // stopped inside a porous volume (crop, crown): the rest of the beam goes on
 };
 
 class RayCaster {
@@ -32,12 +33,13 @@ class RayCaster {
   // Bins objects by the world azimuth under which they appear from `sensor` (world). `swept` holds each
   // object's bounds over the coming rotation (moving objects) and `margin_m` covers the sensor's own motion.
   void prepare(Vec3 sensor, double margin_m, std::span<const Aabb> swept);
-  // The tractor's body alone (fixed in the sensor frame, so callers compute it once per firing direction).
-  [[nodiscard]] CastHit cast_body(Vec3 dir_sensor) const;
-  // Everything: `body` is cast_body(dir_sensor). `moving`, if given, stands in for the scene's pedestrian
-  // (each thread animates its own copy).
+  // The tractor's body alone (fixed in the sensor frame, so callers compute it once per firing ray).
+  [[nodiscard]] CastHit cast_body(Vec3 origin_sensor, Vec3 dir_sensor) const;
+  // Everything, from pose.position: `body` is cast_body() of the same ray. `moving`, if given, stands in for the
+  // scene's pedestrian (each thread animates its own copy). Only what lies beyond `from_m` along the ray counts: a
+  // ray that stopped in a porous volume at from_m goes on from there (and may stop again in the same volume).
   [[nodiscard]] CastHit cast(const SensorPose& pose, Vec3 dir_sensor, const CastHit& body, Rng& rng,
-                             const SceneObject* moving = nullptr) const;
+                             const SceneObject* moving = nullptr, double from_m = 0.0) const;
 
   [[nodiscard]] std::int64_t crop_target(std::size_t crop) const {
     return static_cast<std::int64_t>(scene_.objects.size() + crop);

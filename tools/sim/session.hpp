@@ -1,11 +1,11 @@
 #pragma once
-// The other sensors of a recorded session, written beside the HDL-32E capture in the layout `fieldguard
+// The other sensors of a recorded session, written beside the LiDAR capture in the layout `fieldguard
 // record` uses (README "record saves ..."; io/byte_log.hpp): DIR/gnss.log (NMEA GGA, RMC, HDT of an RTK
 // receiver), DIR/ahrs.log (Xsens MTData2: PacketCounter, SampleTimeFine, EulerAngles ENU) and
 // DIR/scan2d.log (the SCIP 2.0 conversation of a UTM-30LX-EW on the front bumper: start-up, MD, scans),
 // plus DIR/pose.truth.jsonl, the true pose behind every sample.
 //
-// Clocks: the simulation's time 0 is SimSettings::start_time_ns (UTC; the HDL-32E's first firing). GNSS
+// Clocks: the simulation's time 0 is SimSettings::start_time_ns (UTC; the LiDAR's first firing). GNSS
 // epochs are on UTC tenths; the AHRS counts SampleTimeFine (10 kHz) and the scanner its ms counter from
 // arbitrary power-on values, each with its own crystal's drift. Every record's host receive time is the
 // sensor's time plus the link's latency and transmission time plus a little jitter, increasing in each log.

@@ -54,6 +54,7 @@ std::string truth_json_line(const FrameTruth& t) {
   }
   s += ", \"period_s\": ";
   append_number(s, t.period_s, 6);
+  s += R"(, "sensor": ")" + std::string(t.sensor) + '"';
   s += ", \"roll_deg\": ";
   append_number(s, t.roll_deg, 3);
   s += ", \"pitch_deg\": ";
