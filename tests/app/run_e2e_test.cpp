@@ -126,7 +126,10 @@ class RunE2e : public ::testing::Test {
     pcap_ = capture_->pcap;
     truth_ = capture_->truth;
   }
-  static void TearDownTestSuite() { capture_.reset(); }
+  static void TearDownTestSuite() {
+    capture_.reset();
+    rs32_.reset();
+  }
 
   // The shipped configuration with the LiDAR on `port`, a candump log, a zone 0.6 m wide (each crossing
   // walks into it and out again), and two workers.
@@ -191,14 +194,18 @@ class RunE2e : public ::testing::Test {
     if (live_time) a.emplace_back("--live-time");  // a PPS-synchronised LiDAR's clock: UTC, as the GNSS's
     return a;
   }
-  void pedestrian_stops_clear_goes_silence_stops(bool fused);
+  // fused: every sensor live (HDL-32E); rs32: the RS-LiDAR-32's capture instead, model auto, MSOP and DIFOP each
+  // on its own port.
+  void pedestrian_stops_clear_goes_silence_stops(bool fused, bool rs32 = false);
 
   testing::TempDir dir;
   static std::unique_ptr<testing::PedestrianCapture> capture_;
+  static std::unique_ptr<testing::PedestrianCapture> rs32_;  // made by the RS-32 test when it runs
   static std::string pcap_;
   static std::string truth_;
 };
 std::unique_ptr<testing::PedestrianCapture> RunE2e::capture_;
+std::unique_ptr<testing::PedestrianCapture> RunE2e::rs32_;
 std::string RunE2e::pcap_;
 std::string RunE2e::truth_;
 
@@ -212,9 +219,19 @@ TEST_F(RunE2e, FusedFromEveryLiveSensorPedestrianStopsClearGoesSilenceStops) {
   pedestrian_stops_clear_goes_silence_stops(true);
 }
 
-void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
+// The same with an RS-LiDAR-32 (the sensor of the published work): its MSOP and DIFOP on loopback, the shipped
+// configuration unchanged but for the ports (model auto tells the sensor from its packets).
+TEST_F(RunE2e, Rs32PedestrianStopsClearGoesSilenceStops) {
+  rs32_ = std::make_unique<testing::PedestrianCapture>(kRotations, "rs32");
+  ASSERT_TRUE(rs32_->ok) << rs32_->command;
+  pedestrian_stops_clear_goes_silence_stops(false, true);
+}
+
+void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused, bool rs32) {
   const std::uint16_t port = free_udp_port();
   const auto log = dir.path() / "can.log";
+  std::uint16_t msop_port = 0;
+  std::uint16_t difop_port = 0;
   std::optional<Process> scip;
   std::optional<Process> nav;
   fs::path config;
@@ -229,6 +246,12 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
       std::this_thread::sleep_for(10ms);
     }
     config = write_fused_config(port, scip_port, log);
+  } else if (rs32) {
+    config = write_config(port, log);
+    const auto loaded = app::load_config_file(config.string());
+    ASSERT_TRUE(loaded.ok());
+    msop_port = loaded.config.lidar.msop_port;
+    difop_port = loaded.config.lidar.difop_port;
   } else {
     config = write_config(port, log);
   }
@@ -250,7 +273,13 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
     EXPECT_TRUE(daemon.wait_for("the stop zone keeps its full-speed length", 5s)) << daemon.output();
     std::this_thread::sleep_for(1500ms);
   }
-  {
+  if (rs32) {
+    ASSERT_TRUE(daemon.wait_for(std::to_string(msop_port) + " (RS-32 MSOP)", 1s)) << daemon.output();
+    Process player({FIELDGUARD_UDP_PLAYER, "--pcap", rs32_->pcap, "--map", "6699:" + std::to_string(msop_port), "--map",
+                    "7788:" + std::to_string(difop_port)},
+                   dir.path() / "player.out");
+    ASSERT_EQ(player.exited(120s), 0) << slurp(dir.path() / "player.out");
+  } else {
     Process player(player_argv(port, fused), dir.path() / "player.out");
     ASSERT_EQ(player.exited(120s), 0) << slurp(dir.path() / "player.out");
   }
@@ -264,6 +293,10 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   ASSERT_GT(silent_us, 0) << player_out;
   // The LiDAR is silent now: the daemon must say so (timeout 0.3 s) while it keeps running.
   ASSERT_TRUE(daemon.wait_for("lidar silent", 30s)) << daemon.output();
+  if (rs32) {
+    EXPECT_NE(daemon.output().find("3D LiDAR: RS-32 (RS-32 MSOP packets on port"), std::string::npos)
+        << daemon.output();
+  }
   // Priorities as journald reads them: the silent sensor a warning (`journalctl -p warning` shows it), the
   // obstacle stop and the go information; every line carries one.
   EXPECT_NE(daemon.output().find("<4>[safety] warning: "), std::string::npos) << daemon.output();
@@ -345,7 +378,7 @@ void RunE2e::pedestrian_stops_clear_goes_silence_stops(bool fused) {
   for (int k = 1; k < kRotations - 1; ++k) EXPECT_EQ(d.by_frame.count(k), 1U) << "rotation " << k << " was not decided";
 
   // Truth: where the pedestrian is per rotation (rotation k of the capture = frame counter k).
-  const auto truth = testing::json_lines(slurp(truth_));
+  const auto truth = testing::json_lines(slurp(rs32 ? rs32_->truth : truth_));
   ASSERT_EQ(truth.size(), static_cast<std::size_t>(kRotations));
   enum class Where { Inside, Far, Between };
   std::vector<Where> where;

@@ -34,10 +34,11 @@ inline std::size_t count_lines(const std::string& s) {
 // `fieldguard-sim --scene pedestrian --rotations N` into a temporary directory (a few seconds: write it once per
 // test suite). `ok` says whether the simulator succeeded; `command` is what was run.
 struct PedestrianCapture {
-  explicit PedestrianCapture(int rotations)
+  // `sensor`: fieldguard-sim's --sensor (hdl32e, vlp16, rs32).
+  explicit PedestrianCapture(int rotations, const std::string& sensor = "hdl32e")
       : pcap((dir.path() / "ped.pcap").string()), truth((dir.path() / "ped.truth.jsonl").string()) {
     command = std::string("'") + FIELDGUARD_SIM + "' --scene pedestrian --rotations " + std::to_string(rotations) +
-              " --quiet --pcap '" + pcap + "' --truth '" + truth + "'";
+              " --sensor " + sensor + " --quiet --pcap '" + pcap + "' --truth '" + truth + "'";
     ok = std::system(command.c_str()) == 0;
   }
   TempDir dir;
