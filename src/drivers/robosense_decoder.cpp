@@ -31,12 +31,6 @@ constexpr std::uint16_t kGroupFlag = 0x8000;
 std::size_t block_offset(std::size_t b) { return kHeaderSize + b * kBlockSize; }
 std::size_t slot_offset(std::size_t b, std::size_t slot) { return block_offset(b) + 4 + 3 * slot; }
 
-double wrap_cdeg(double a) {
-  a = std::fmod(a, static_cast<double>(kFullTurnCdeg));
-  if (a < 0.0) a += kFullTurnCdeg;
-  return a;
-}
-
 std::uint16_t round_cdeg(double wrapped) {
   const long r = std::lround(wrapped);
   return static_cast<std::uint16_t>(r >= kFullTurnCdeg ? r - kFullTurnCdeg : r);
@@ -149,6 +143,21 @@ void Decoder::set_calibration(const Calibration& c) {
                         .horiz_cdeg = static_cast<float>(c.horiz_deg[i] * 100.0),
                         .ring = ring};
   }
+  turns_.resize(static_cast<std::size_t>(kMaxGroupStepCdeg) + 1);
+  for (std::size_t step = 0; step < turns_.size(); ++step) fill_turns(static_cast<double>(step), turns_[step]);
+}
+
+void Decoder::fill_turns(double step_cdeg, std::array<ChannelTurn, kChannels>& out) const {
+  constexpr double kRadPerCdeg = std::numbers::pi / 180.0 / 100.0;
+  for (std::size_t c = 0; c < kChannels; ++c) {
+    const double share = step_cdeg * (kFiringOffsetUs[c] / kBlockDurationUs);
+    const double offset = share + static_cast<double>(table_[c].horiz_cdeg);
+    out[c] = ChannelTurn{.cos_a = std::cos(offset * kRadPerCdeg),
+                         .sin_a = std::sin(offset * kRadPerCdeg),
+                         .cos_f = std::cos(share * kRadPerCdeg),
+                         .sin_f = std::sin(share * kRadPerCdeg),
+                         .offset_cdeg = offset};
+  }
 }
 
 bool Decoder::apply(const DifopInfo& d) {
@@ -203,7 +212,6 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarP
   const double max_r = options_.max_range_m;
   const double offset_m = options_.optical_centre_offset_m;
   const ReturnType single_type = mode == ReturnMode::Last ? ReturnType::Last : ReturnType::Strongest;
-  constexpr double kRadPerCdeg = std::numbers::pi / 18000.0;
 
   // Raw distance of channel c in block b (slot swap and flag of the old firmware's B blocks).
   auto raw_of = [&](std::size_t b, std::size_t c, std::uint8_t& intensity) {
@@ -214,16 +222,29 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarP
     return grouped ? static_cast<std::uint16_t>(raw & ~kGroupFlag) : raw;
   };
 
+  constexpr double kRadPerCdeg = std::numbers::pi / 180.0 / 100.0;
+  std::array<ChannelTurn, kChannels> odd_step{};  // a step with no table row (a fraction of 0.01 deg, or too big)
   for (std::size_t g = 0; g < groups; ++g) {
+    // Each firing's azimuth is the group's turned by the channel's share of the step (and its correction): the
+    // group's cosine and sine once, each channel's turn from the table of its step (no trigonometry per point).
+    const double cos_g = std::cos(az[g] * kRadPerCdeg);
+    const double sin_g = std::sin(az[g] * kRadPerCdeg);
+    const double group_step = delta[g];
+    const auto whole = static_cast<std::size_t>(group_step);
+    const bool tabled = static_cast<double>(whole) == group_step && whole < turns_.size();
+    if (!tabled) fill_turns(group_step, odd_step);
+    const std::array<ChannelTurn, kChannels>& turns = tabled ? turns_[whole] : odd_step;
     for (std::size_t c = 0; c < kChannels; ++c) {
       const Channel& ch = table_[c];
+      const ChannelTurn& t = turns[c];
       const double fire_us = static_cast<double>(g) * kBlockDurationUs + kFiringOffsetUs[c];
-      const double a0 = wrap_cdeg(az[g] + delta[g] * (kFiringOffsetUs[c] / kBlockDurationUs));
-      const double a = wrap_cdeg(a0 + static_cast<double>(ch.horiz_cdeg));
-      const double cos_a = std::cos(a * kRadPerCdeg);
-      const double sin_a = std::sin(a * kRadPerCdeg);
-      const double off_x = offset_m * std::cos(a0 * kRadPerCdeg);
-      const double off_y = -offset_m * std::sin(a0 * kRadPerCdeg);
+      double a = az[g] + t.offset_cdeg;  // within a turn and a half of 0: no fmod
+      if (a >= kFullTurnCdeg) a -= kFullTurnCdeg;
+      if (a < 0.0) a += kFullTurnCdeg;
+      const double cos_a = cos_g * t.cos_a - sin_g * t.sin_a;
+      const double sin_a = sin_g * t.cos_a + cos_g * t.sin_a;
+      const double off_x = offset_m * (cos_g * t.cos_f - sin_g * t.sin_f);
+      const double off_y = -offset_m * (sin_g * t.cos_f + cos_g * t.sin_f);
 
       auto emit = [&](std::uint16_t raw, std::uint8_t intensity, ReturnType type) {
         const double d = static_cast<double>(raw) * unit_m;

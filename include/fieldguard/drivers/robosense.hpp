@@ -187,6 +187,18 @@ class Decoder {
     std::uint16_t ring = 0;
   };
   std::array<Channel, kChannels> table_{};
+  // A channel's firing azimuth past its group's, for a group step of so many 0.01 deg: the step's share up to the
+  // channel's firing (and the optical centre's direction, which keeps that), plus its horizontal correction.
+  struct ChannelTurn {
+    double cos_a = 1.0;
+    double sin_a = 0.0;
+    double cos_f = 1.0;
+    double sin_f = 0.0;
+    double offset_cdeg = 0.0;
+  };
+  void fill_turns(double step_cdeg, std::array<ChannelTurn, kChannels>& out) const;
+  // By whole step, 0 .. 100 (0.01 deg; 1200 rpm steps 40 a group, 80 a dual pair); filled with the angle table.
+  std::vector<std::array<ChannelTurn, kChannels>> turns_;
 };
 
 }  // namespace fieldguard::robosense
