@@ -31,8 +31,9 @@ constexpr std::uint16_t kGroupFlag = 0x8000;
 std::size_t block_offset(std::size_t b) { return kHeaderSize + b * kBlockSize; }
 std::size_t slot_offset(std::size_t b, std::size_t slot) { return block_offset(b) + 4 + 3 * slot; }
 
+// [0, 36000) to the nearest 0.01 deg, half away from zero as std::lround (the argument is never negative).
 std::uint16_t round_cdeg(double wrapped) {
-  const long r = std::lround(wrapped);
+  const auto r = static_cast<int>(wrapped + 0.5);
   return static_cast<std::uint16_t>(r >= kFullTurnCdeg ? r - kFullTurnCdeg : r);
 }
 
@@ -177,6 +178,18 @@ bool Decoder::apply(const DifopInfo& d) {
 }
 
 Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarPoint>& out) const {
+  const std::size_t before = out.size();
+  out.resize(before + kMaxPointsPerPacket);
+  std::size_t written = 0;
+  auto header = decode(p, std::span<LidarPoint>(out).subspan(before), written);
+  out.resize(before + written);
+  return header;
+}
+
+Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::span<LidarPoint> room, std::size_t& written,
+                                                  AzimuthRange* azimuths) const {
+  written = 0;
+  if (room.size() < kMaxPointsPerPacket) throw std::invalid_argument("RS-32 decode: room for fewer than 384 points");
   auto header = read_msop_header(p);
   if (!header) return header;
   if (!ready()) return Unexpected{DecodeError::NoCalibration};
@@ -223,6 +236,8 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarP
   };
 
   constexpr double kRadPerCdeg = std::numbers::pi / 180.0 / 100.0;
+  std::uint16_t min_cdeg = kFullTurnCdeg - 1;  // bounds on the firings' azimuths, for the rotation assembler
+  std::uint16_t max_cdeg = 0;
   std::array<ChannelTurn, kChannels> odd_step{};  // a step with no table row (a fraction of 0.01 deg, or too big)
   for (std::size_t g = 0; g < groups; ++g) {
     // Each firing's azimuth is the group's turned by the channel's share of the step (and its correction): the
@@ -246,20 +261,23 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarP
       const double off_x = offset_m * (cos_g * t.cos_f - sin_g * t.sin_f);
       const double off_y = -offset_m * (sin_g * t.cos_f + cos_g * t.sin_f);
 
-      auto emit = [&](std::uint16_t raw, std::uint8_t intensity, ReturnType type) {
+      const std::uint16_t a_cdeg = round_cdeg(a);
+      min_cdeg = std::min(min_cdeg, a_cdeg);
+      max_cdeg = std::max(max_cdeg, a_cdeg);
+      const auto emit = [&](std::uint16_t raw, std::uint8_t intensity, ReturnType type) {
         const double d = static_cast<double>(raw) * unit_m;
         const double xy = d * static_cast<double>(ch.cos_vert);
-        LidarPoint pt;
-        pt.x = static_cast<float>(xy * cos_a + off_x);
-        pt.y = static_cast<float>(-xy * sin_a + off_y);
-        pt.z = static_cast<float>(d * static_cast<double>(ch.sin_vert));
-        pt.intensity = static_cast<float>(intensity);
-        pt.time_s = static_cast<float>(fire_us * 1e-6);
-        pt.range_m = static_cast<float>(d);
-        pt.azimuth_cdeg = round_cdeg(a);
-        pt.ring = ch.ring;
-        pt.return_type = type;
-        out.push_back(pt);
+        room[written++] = LidarPoint{.x = static_cast<float>(xy * cos_a + off_x),
+                                     .y = static_cast<float>(-xy * sin_a + off_y),
+                                     .z = static_cast<float>(d * static_cast<double>(ch.sin_vert)),
+                                     .intensity = static_cast<float>(intensity),
+                                     .time_s = static_cast<float>(fire_us * 1e-6),
+                                     .range_m = static_cast<float>(d),
+                                     .azimuth_cdeg = a_cdeg,
+                                     .ring = ch.ring,
+                                     .return_type = type,
+                                     .source = 0,
+                                     .reserved1 = 0};
       };
       auto valid = [&](std::uint16_t raw) {
         const double d = static_cast<double>(raw) * unit_m;
@@ -284,6 +302,7 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::vector<LidarP
       if (valid(r1)) emit(r1, i1, valid(r0) && r1 < r0 ? ReturnType::SecondStrongest : ReturnType::Last);
     }
   }
+  if (azimuths != nullptr) *azimuths = min_cdeg <= max_cdeg ? AzimuthRange{min_cdeg, max_cdeg} : AzimuthRange{};
   return header;
 }
 

@@ -36,16 +36,18 @@ void Stream::push_difop(ByteSpan payload) {
 
 void Stream::push_msop(ByteSpan payload, Stamp host_time, std::vector<LidarFrame>& frames) {
   ++counters_.msop_packets;
-  scratch_.clear();
-  const auto header = decoder_.decode(payload, scratch_);
+  // Straight into the rotation under construction (no copy through a scratch buffer).
+  std::size_t written = 0;
+  AzimuthRange azimuths;
+  const auto header = decoder_.decode(payload, assembler_.append_room(kMaxPointsPerPacket), written, &azimuths);
   if (!header) {
     ++counters_.msop_errors[static_cast<std::size_t>(header.error())];
     return;
   }
   ++counters_.msop_decoded;
-  counters_.points += scratch_.size();
+  counters_.points += written;
   const std::size_t before = frames.size();
-  assembler_.push(scratch_, header->sensor_time, host_time, frames);
+  assembler_.commit(written, header->sensor_time, host_time, frames, azimuths);
   count_frames(frames, before);
 }
 

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "fieldguard/core/expected.hpp"
 #include "fieldguard/core/lidar_point.hpp"
 #include "fieldguard/core/time.hpp"
+#include "fieldguard/drivers/rotation_assembler.hpp"
 
 namespace fieldguard::robosense {
 
@@ -31,6 +33,8 @@ inline constexpr std::size_t kBlockSize = 100;
 inline constexpr std::size_t kChannels = 32;
 inline constexpr std::uint16_t kDefaultMsopPort = 6699;
 inline constexpr std::uint16_t kDefaultDifopPort = 7788;
+// Most points an MSOP packet yields: 12 blocks of 32 (single return), or 6 pairs of 32 firings with two (dual).
+inline constexpr std::size_t kMaxPointsPerPacket = kBlocksPerPacket * kChannels;
 
 // Firing timing (rs_driver decoder_RS32.hpp, and the RS-LiDAR-32 manual appendix A.1/A.2, whose formula
 // 55.52*(seq-1) + 2.88*mod(ch-1,16) + 1.44*floor(ch/16) reproduces this table): one block of 32 firings lasts
@@ -163,6 +167,10 @@ class Decoder {
   // Appends the packet's points to `out`. time_s of each point is seconds after the packet's sensor_time.
   // Returns NoCalibration (after checking the header) while !ready().
   Expected<MsopHeader, DecodeError> decode(ByteSpan payload, std::vector<LidarPoint>& out) const;
+  // The same into `room` (at least kMaxPointsPerPacket long: RotationAssembler::append_room()): `written` points,
+  // and when `azimuths` is given, bounds on their azimuth_cdeg (for RotationAssembler::commit()).
+  Expected<MsopHeader, DecodeError> decode(ByteSpan payload, std::span<LidarPoint> room, std::size_t& written,
+                                           AzimuthRange* azimuths = nullptr) const;
 
   [[nodiscard]] const std::optional<Calibration>& calibration() const { return calibration_; }
   [[nodiscard]] bool nominal() const { return nominal_; }  // decoding with the nominal table, no DIFOP's yet

@@ -60,7 +60,6 @@ class Stream {
   Decoder decoder_;
   RotationAssembler assembler_;
   std::optional<DifopInfo> last_difop_;
-  std::vector<LidarPoint> scratch_;
   StreamCounters counters_;
 };
 
