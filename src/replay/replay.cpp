@@ -653,6 +653,14 @@ int Replay::finish() {
                  pcap_path_.c_str(), id.name.empty() ? "an unknown sensor" : id.name.c_str(), id.detail.c_str());
     return kExitBadInput;
   }
+  if (counts.data_packets == 0 && counts.other_family != 0) {
+    std::fprintf(stderr,
+                 "fieldguard replay: %s holds only packets of another 3D LiDAR than lidar.model %s (%llu dropped): "
+                 "set lidar.model to auto or to the sensor's model\n",
+                 pcap_path_.c_str(), std::string(lidar3d::to_string(cfg_.lidar.model)).c_str(),
+                 static_cast<unsigned long long>(counts.other_family));
+    return kExitBadInput;
+  }
   if (counts.data_packets == 0) {
     std::fprintf(stderr,
                  "fieldguard replay: %s holds no UDP datagram to the data port %u (Velodyne) or the MSOP port %u "

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -176,6 +178,40 @@ TEST(Replay, NoDataPortTrafficIsUnusable) {
   auto r = run_fieldguard(replay(dir.write("other.pcap", pcap.bytes())));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("no UDP datagram to the data port 2368"), std::string::npos) << r.output;
+}
+
+// RS-32 MSOP headers (model byte at 30), otherwise empty: enough for the stream to tell the sensor.
+Bytes msop_payload(std::uint8_t model_byte) {
+  Bytes b(1248, 0);
+  const std::uint8_t header[] = {0x55, 0xAA, 0x05, 0x0A, 0x5A, 0xA5, 0x50, 0xA0};
+  std::copy(std::begin(header), std::end(header), b.begin());
+  b[30] = model_byte;
+  return b;
+}
+
+// The model says one family, the capture holds the other's packets: the error says so instead of "no datagram".
+TEST(Replay, AnotherLidarFamilyThanTheModelIsNamed) {
+  testing::ClassicPcap pcap;
+  for (int i = 0; i < 3; ++i) pcap.add(frame_for(msop_payload(0x02), 6699), 1000 * (i + 1));
+  testing::TempDir dir;
+  const auto cfg = dir.write("hdl.yaml", Bytes{});
+  std::ofstream(cfg) << "lidar: {model: HDL-32E}\n";
+  auto r = run_fieldguard("replay --config '" + cfg + "' --pcap '" + dir.write("rs.pcap", pcap.bytes()) + "'");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("holds only packets of another 3D LiDAR than lidar.model HDL-32E (3 dropped)"),
+            std::string::npos)
+      << r.output;
+}
+
+// MSOP packets of another RoboSense model: refused and named, never decoded as RS-32 ones.
+TEST(Replay, AnotherRoboSenseModelIsRefusedByName) {
+  testing::ClassicPcap pcap;
+  for (int i = 0; i < 3; ++i) pcap.add(frame_for(msop_payload(0x01), 6699), 1000 * (i + 1));
+  testing::TempDir dir;
+  auto r = run_fieldguard(replay(dir.write("rs16.pcap", pcap.bytes())));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("MSOP packets of RS-LiDAR-16 (model byte 0x01)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("msop_refused            3"), std::string::npos) << r.output;
 }
 
 TEST(Replay, InvalidConfigIsRefused) {
