@@ -235,6 +235,11 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::span<LidarPoi
     return grouped ? static_cast<std::uint16_t>(raw & ~kGroupFlag) : raw;
   };
 
+  const auto valid = [&](std::uint16_t raw) {
+    const double d = static_cast<double>(raw) * unit_m;
+    return raw != 0 && d >= min_r && d <= max_r;
+  };
+
   constexpr double kRadPerCdeg = std::numbers::pi / 180.0 / 100.0;
   std::uint16_t min_cdeg = kFullTurnCdeg - 1;  // bounds on the firings' azimuths, for the rotation assembler
   std::uint16_t max_cdeg = 0;
@@ -250,6 +255,15 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::span<LidarPoi
     if (!tabled) fill_turns(group_step, odd_step);
     const std::array<ChannelTurn, kChannels>& turns = tabled ? turns_[whole] : odd_step;
     for (std::size_t c = 0; c < kChannels; ++c) {
+      // The returns first: a firing without one (a third of them in a field) costs no geometry.
+      std::uint8_t i0 = 0;
+      const std::uint16_t r0 = raw_of(g * step, c, i0);
+      std::uint8_t i1 = 0;
+      const std::uint16_t r1 = dual ? raw_of(g * step + 1, c, i1) : std::uint16_t{0};
+      const bool v0 = valid(r0);
+      const bool v1 = dual && valid(r1);
+      if (!v0 && !v1) continue;
+
       const Channel& ch = table_[c];
       const ChannelTurn& t = turns[c];
       const double fire_us = static_cast<double>(g) * kBlockDurationUs + kFiringOffsetUs[c];
@@ -260,7 +274,6 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::span<LidarPoi
       const double sin_a = sin_g * t.cos_a + cos_g * t.sin_a;
       const double off_x = offset_m * (cos_g * t.cos_f - sin_g * t.sin_f);
       const double off_y = -offset_m * (sin_g * t.cos_f + cos_g * t.sin_f);
-
       const std::uint16_t a_cdeg = round_cdeg(a);
       min_cdeg = std::min(min_cdeg, a_cdeg);
       max_cdeg = std::max(max_cdeg, a_cdeg);
@@ -279,27 +292,18 @@ Expected<MsopHeader, DecodeError> Decoder::decode(ByteSpan p, std::span<LidarPoi
                                      .source = 0,
                                      .reserved1 = 0};
       };
-      auto valid = [&](std::uint16_t raw) {
-        const double d = static_cast<double>(raw) * unit_m;
-        return raw != 0 && d >= min_r && d <= max_r;
-      };
-
-      std::uint8_t i0 = 0;
-      const std::uint16_t r0 = raw_of(g * step, c, i0);
       if (!dual) {
-        if (valid(r0)) emit(r0, i0, single_type);
+        emit(r0, i0, single_type);
         continue;
       }
       // Dual: the first block of a pair holds the strongest return, the second the last one, or the second
       // strongest when the strongest is also the last (manual appendix A.2 and 7.1.3): nearer = second strongest.
-      std::uint8_t i1 = 0;
-      const std::uint16_t r1 = raw_of(g * step + 1, c, i1);
       if (r0 == r1 && i0 == i1) {
-        if (valid(r0)) emit(r0, i0, ReturnType::StrongestAndLast);
+        emit(r0, i0, ReturnType::StrongestAndLast);
         continue;
       }
-      if (valid(r0)) emit(r0, i0, ReturnType::Strongest);
-      if (valid(r1)) emit(r1, i1, valid(r0) && r1 < r0 ? ReturnType::SecondStrongest : ReturnType::Last);
+      if (v0) emit(r0, i0, ReturnType::Strongest);
+      if (v1) emit(r1, i1, v0 && r1 < r0 ? ReturnType::SecondStrongest : ReturnType::Last);
     }
   }
   if (azimuths != nullptr) *azimuths = min_cdeg <= max_cdeg ? AzimuthRange{min_cdeg, max_cdeg} : AzimuthRange{};
