@@ -16,6 +16,15 @@ RingJitterMeter::RingJitterMeter(double ring_spacing_deg, double max_gap_m)
   }
 }
 
+void RingJitterMeter::set_beams(const BeamGeometry& beams) {
+  if (beams.is_uniform()) {
+    group_gap_rad_ = static_cast<float>(0.5 * beams.min_spacing_deg() * std::numbers::pi / 180.0);
+    beams_.reset();
+  } else {
+    beams_ = beams;
+  }
+}
+
 RingJitter RingJitterMeter::measure(const Cloud& cloud, std::span<const std::uint32_t> indices) {
   RingJitter out;
   samples_.clear();
@@ -46,7 +55,13 @@ RingJitter RingJitterMeter::measure(const Cloud& cloud, std::span<const std::uin
   while (g0 < samples_.size()) {
     // One ring: elevations without a jump of half the ring spacing.
     std::size_t g1 = g0 + 1;
-    while (g1 < samples_.size() && samples_[g1].elevation - samples_[g1 - 1].elevation <= group_gap_rad_) ++g1;
+    const auto gap_at = [&](float elevation) {
+      return beams_ ? 0.5F * beams_->spacing_rad(std::sin(elevation)) : group_gap_rad_;
+    };
+    while (g1 < samples_.size() &&
+           samples_[g1].elevation - samples_[g1 - 1].elevation <= gap_at(samples_[g1 - 1].elevation)) {
+      ++g1;
+    }
     const auto first = samples_.begin() + static_cast<std::ptrdiff_t>(g0);
     const auto last = samples_.begin() + static_cast<std::ptrdiff_t>(g1);
     std::sort(first, last, [](const Sample& a, const Sample& b) { return a.bearing < b.bearing; });

@@ -197,7 +197,13 @@ bool ClusterSplitter::find_cut(const Cloud& cloud, const EuclideanClusterer& clu
       const float r = 0.5F * (range_of(last->hi_i) + range_of(slot.lo_i));
       const float scale = r > full ? (full / r) * (full / r) : 1.F;
       const auto need = static_cast<std::size_t>(std::ceil(part_points * scale));
-      const float ratio = gap / clusterer.horizontal_radius_at(r);
+      // The horizontal radius between the two points beside the gap (at their mean elevation's rings).
+      const auto sin_of = [&](std::uint32_t i) {
+        const float ri = range_of(i);
+        return ri > 0.F ? cloud.z[i] / ri : 0.F;
+      };
+      const float sin_mid = 0.5F * (sin_of(last->hi_i) + sin_of(slot.lo_i));
+      const float ratio = gap / clusterer.horizontal_radius_at(r, sin_mid);
       if (before >= need && after >= need && ratio >= ratio_min && ratio > best_ratio) {
         best_ratio = ratio;
         cut = 0.5F * (last->hi + slot.lo);

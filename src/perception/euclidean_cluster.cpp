@@ -19,27 +19,44 @@ EuclideanClusterer::EuclideanClusterer(const ClusterParams& params) : params_(pa
   base_r2_ = static_cast<float>(static_cast<double>(t) * static_cast<double>(t));
   anisotropic_ = params_.method == ClusterMethod::Anisotropic;
   adaptive_ = params_.method == ClusterMethod::Adaptive || anisotropic_;
-  if (adaptive_) {
-    const double spacing = std::tan(params_.beam_spacing_deg * std::numbers::pi / 180.0);
-    const double g = params_.beam_factor * spacing;
-    if (!(g >= 0.0 && g < 0.5)) {
-      throw std::invalid_argument("EuclideanClusterer: beam_factor * tan(beam_spacing_deg) must be in [0, 0.5)");
-    }
-    growth_ = static_cast<float>(g);
-    cap_ = static_cast<float>(std::max(params_.max_tolerance_m, params_.tolerance_m));
-    if (anisotropic_) {
-      const double gh = params_.horizontal_beam_factor * spacing;
-      if (!(gh >= 0.0 && gh < 0.5)) {
-        throw std::invalid_argument(
-            "EuclideanClusterer: horizontal_beam_factor * tan(beam_spacing_deg) must be in [0, 0.5)");
-      }
-      if (!std::isfinite(params_.horizontal_max_tolerance_m)) {
-        throw std::invalid_argument("EuclideanClusterer: horizontal_max_tolerance_m must be finite");
-      }
-      growth_h_ = static_cast<float>(gh);
-      cap_h_ = static_cast<float>(std::max(params_.horizontal_max_tolerance_m, params_.tolerance_m));
-    }
+  apply_beams(params_.beam_spacing_deg > 0.0 ? BeamGeometry::uniform(params_.beam_spacing_deg) : BeamGeometry{}, true);
+}
+
+void EuclideanClusterer::set_beams(const BeamGeometry& beams) { apply_beams(beams, false); }
+
+void EuclideanClusterer::apply_beams(const BeamGeometry& beams, bool configured) {
+  beams_ = beams;
+  per_point_ = adaptive_ && !beams_.is_uniform();
+  if (!adaptive_) return;
+  if (!(params_.beam_factor >= 0.0) || !(params_.horizontal_beam_factor >= 0.0)) {
+    throw std::invalid_argument("EuclideanClusterer: the beam factors must not be negative");
   }
+  if (!std::isfinite(params_.horizontal_max_tolerance_m)) {
+    throw std::invalid_argument("EuclideanClusterer: horizontal_max_tolerance_m must be finite");
+  }
+  constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+  // Vertical: the rings' spacing (per point on uneven rings: these are its extremes). Horizontal: the configured
+  // spacing, else the HDL-32E's whatever the sensor: along a ring the gaps the radius bridges are a surface's own
+  // (a porous crown's), not the distance between rings.
+  const double v_hi = params_.beam_factor * std::tan(beams_.max_spacing_deg() * kRadPerDeg);
+  const double v_lo = params_.beam_factor * std::tan(beams_.min_spacing_deg() * kRadPerDeg);
+  const double h_spacing = configured ? beams_.min_spacing_deg() : BeamGeometry{}.min_spacing_deg();
+  const double h = params_.horizontal_beam_factor * std::tan(h_spacing * kRadPerDeg);
+  if (configured && !(v_hi < 0.5)) {
+    throw std::invalid_argument("EuclideanClusterer: beam_factor * tan(beam_spacing_deg) must be in [0, 0.5)");
+  }
+  if (configured && anisotropic_ && !(h < 0.5)) {
+    throw std::invalid_argument(
+        "EuclideanClusterer: horizontal_beam_factor * tan(beam_spacing_deg) must be in [0, 0.5)");
+  }
+  // A sensor's spacing held at kMaxGrowth (on a configured one that would have been an error above).
+  const auto held = [](double g) { return static_cast<float>(std::min(g, static_cast<double>(kMaxGrowth))); };
+  growth_ = held(v_hi);
+  min_growth_ = held(v_lo);
+  growth_h_ = anisotropic_ ? held(h) : 0.F;
+  min_growth_h_ = growth_h_;
+  cap_ = static_cast<float>(std::max(params_.max_tolerance_m, params_.tolerance_m));
+  cap_h_ = anisotropic_ ? static_cast<float>(std::max(params_.horizontal_max_tolerance_m, params_.tolerance_m)) : 0.F;
 }
 
 // A radius that grows with range: tolerance_m up close, `growth` per metre of range farther out, at most `cap`.
@@ -53,6 +70,13 @@ EuclideanClusterer::RadiusModel EuclideanClusterer::radius_model() const {
 
 float EuclideanClusterer::horizontal_radius_at(float range_m) const {
   return anisotropic_ ? grown(growth_h_, cap_h_, range_m) : radius_at(range_m);
+}
+
+float EuclideanClusterer::horizontal_radius_at(float range_m, float sin_elevation) const {
+  if (!per_point_) return horizontal_radius_at(range_m);
+  return anisotropic_
+             ? grown(growth_at(static_cast<float>(params_.horizontal_beam_factor), sin_elevation), cap_h_, range_m)
+             : grown(growth_at(static_cast<float>(params_.beam_factor), sin_elevation), cap_, range_m);
 }
 
 float EuclideanClusterer::radius_at(float range_m) const {
@@ -89,9 +113,15 @@ void EuclideanClusterer::prepare(const Cloud& in) {
   const float cap = anisotropic_ ? std::max(cap_, cap_h_) : cap_;
   const float reach = g / (1.F - g);
   const RadiusModel rm = radius_model();
+  const auto fv = static_cast<float>(params_.beam_factor);
   for (std::size_t i = 0; i < n; ++i) {
     const float range = std::sqrt(in.x[i] * in.x[i] + in.y[i] * in.y[i] + in.z[i] * in.z[i]);
-    const float v = rm.v(range), h = rm.h(range);
+    float v = rm.v(range), h = rm.h(range);
+    if (per_point_) {  // this point's elevation's growths
+      const float s = range > 0.F ? in.z[i] / range : 0.F;
+      v = grow(rm.t, growth_at(fv, s), rm.cap_v, range);
+      if (!anisotropic_) h = v;
+    }
     r2_[i] = rm.squared(v);
     if (anisotropic_) h2_[i] = rm.squared(h);
     query_[i] = std::max(std::max(v, h), std::min(cap, reach * range));

@@ -224,6 +224,7 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     };
     const auto squared4 = [&](f32x4 radius) { return radius == vt ? base_r2 : radius * radius; };
     const bool adaptive = adaptive_;
+    const auto fv = static_cast<float>(params_.beam_factor);
     for (std::size_t j = 0; j < n; j += 4) {  // the last four may run into the padding: n + 4 long
       f32x4 x = simd::load(sx + j), y = simd::load(sy + j), z = simd::load(sz + j);
       const u32x4 iz = cells(z, lz, vtop_z);
@@ -236,7 +237,11 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
 #else
         range = f32x4{std::sqrt(sq[0]), std::sqrt(sq[1]), std::sqrt(sq[2]), std::sqrt(sq[3])};
 #endif
-        const f32x4 v2 = squared4(grow4(gv, cap_v, range));
+        f32x4 lane_gv = gv;
+        if (per_point_) {  // each point's vertical growth from its elevation (uneven rings)
+          for (int k = 0; k < 4; ++k) lane_gv[k] = growth_at(fv, range[k] > 0.F ? z[k] / range[k] : 0.F);
+        }
+        const f32x4 v2 = squared4(grow4(lane_gv, cap_v, range));
         const f32x4 hv2 = rm.aniso ? squared4(grow4(gh, cap_h, range)) : v2;
         std::memcpy(r2 + j, &v2, sizeof v2);
         std::memcpy(h2 + j, &hv2, sizeof hv2);
@@ -257,6 +262,10 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   // whose points still all join with the smallest radii at rmin (each axis's extent taken 2 * rounding long).
   // Fewer, taller cells: far walls cost fewer cell pairs. One pass over the columns makes their cells with their
   // point boxes and farthest range.
+  // With uneven rings the smallest growths: what every point of a column is sure to have.
+  RadiusModel rm_min = rm;
+  rm_min.gv = min_growth_;
+  rm_min.gh = min_growth_h_;
   const double e = static_cast<double>(edge), rho2 = 2.0 * static_cast<double>(rounding);
   const auto stack_of = [&](std::size_t c) -> std::uint32_t {
     if (!adaptive_) return 1;
@@ -265,8 +274,8 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     const double dx = std::max({0.0, x0, -(x0 + e + 2.0 * rho2)});
     const double dy = std::max({0.0, y0, -(y0 + e + 2.0 * rho2)});
     const auto rmin = static_cast<float>(std::sqrt(dx * dx + dy * dy));
-    const auto v = static_cast<double>(rm.v(rmin));
-    const auto h = static_cast<double>(rm.h(rmin));
+    const auto v = static_cast<double>(rm_min.v(rmin));
+    const auto h = static_cast<double>(rm_min.h(rmin));
     const double across = 2.0 * (e + rho2) * (e + rho2) / (h * h);
     if (!(across < 0.998)) return 1;
     const double height = std::sqrt((0.998 - across) * v * v) - rho2;  // the tallest cell allowed
@@ -349,6 +358,17 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
     const float range = boxes[8 * std::size_t{c} + 7];
     cl[c].reach2 = adaptive_ ? rm.squared(rm.v(range)) : base_r2_;
     cl[c].hreach2 = adaptive_ ? rm.squared(rm.h(range)) : base_r2_;
+  }
+  if (per_point_) {  // uneven rings: each point has its own growth, so the largest of the cell's own radii
+    for (std::uint32_t c = 0; c < ncells; ++c) {
+      float v2 = 0.F, hv2 = 0.F;
+      for (std::uint32_t j = cl[c].first; j < cl[c + 1].first; ++j) {
+        v2 = std::max(v2, r2[j]);
+        hv2 = std::max(hv2, h2[j]);
+      }
+      cl[c].reach2 = v2;
+      cl[c].hreach2 = hv2;
+    }
   }
 
   // Joins. Each cell looks back at the cells before it in cell order (x column, y column, z) within its

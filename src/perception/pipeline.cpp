@@ -94,7 +94,9 @@ struct Pipeline::Impl {
         joiner(ClusterJoinParams::from(p.cluster)),
         splitter(ClusterSplitParams::from(p.cluster)),
         near(p.near_field),
-        jitter(p.cluster.beam_spacing_deg, p.filters.canopy_max_gap_m) {
+        jitter(BeamGeometry{}.min_spacing_deg(), p.filters.canopy_max_gap_m) {
+    if (p.cluster.beam_spacing_deg > 0.0) beams = BeamGeometry::uniform(p.cluster.beam_spacing_deg);
+    jitter.set_beams(beams);
     if (p.roi.min[0] >= p.roi.max[0] || p.roi.min[1] >= p.roi.max[1] || p.roi.min[2] >= p.roi.max[2]) {
       throw std::invalid_argument("Pipeline: the ROI box needs min < max on every axis");
     }
@@ -106,6 +108,7 @@ struct Pipeline::Impl {
   }
 
   PipelineParams params;
+  BeamGeometry beams;  // in force: the configured spacing, or the sensor's (set_beams), or the HDL-32E's
   VoxelGrid voxel;
   std::optional<RansacGround> ransac;
   std::optional<ZoneGround> zones;
@@ -138,6 +141,18 @@ Pipeline::Pipeline(Pipeline&&) noexcept = default;
 Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
 
 const PipelineParams& Pipeline::params() const { return impl_->params; }
+
+bool Pipeline::set_beams(const BeamGeometry& beams) {
+  Impl& m = *impl_;
+  if (m.params.cluster.beam_spacing_deg > 0.0) return false;
+  if (beams == m.beams) return true;
+  m.clusterer.set_beams(beams);
+  m.jitter.set_beams(beams);
+  m.beams = beams;
+  return true;
+}
+
+const BeamGeometry& Pipeline::beams() const { return impl_->beams; }
 
 std::span<const LabeledPoint> Pipeline::last_points() const { return impl_->labeled; }
 

@@ -17,9 +17,11 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "fieldguard/perception/beam_geometry.hpp"
 #include "fieldguard/perception/cloud.hpp"
 
 namespace fieldguard::perception {
@@ -40,6 +42,9 @@ class RingJitterMeter {
   // `ring_spacing_deg`: the sensor's vertical angle between adjacent rings (HDL-32E 1.33); `max_gap_m`: two
   // points farther apart than this (horizontally) are not neighbours on a ring.
   RingJitterMeter(double ring_spacing_deg, double max_gap_m);
+  // The sensor's rings instead (uneven on an RS-32): samples belong to one ring while their elevations step less
+  // than half the spacing at their elevation.
+  void set_beams(const BeamGeometry& beams);
 
   [[nodiscard]] RingJitter measure(const Cloud& cloud, std::span<const std::uint32_t> indices);
   // Over every point of `cloud`.
@@ -51,7 +56,8 @@ class RingJitterMeter {
   };
   float group_gap_rad_;
   float max_gap_m_;
-  std::vector<Sample> samples_;  // scratch, reused
+  std::optional<BeamGeometry> beams_;  // uneven rings: the gap by elevation
+  std::vector<Sample> samples_;        // scratch, reused
   std::vector<float> offs_;
   std::vector<std::uint32_t> all_;
 };

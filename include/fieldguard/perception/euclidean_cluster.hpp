@@ -16,10 +16,12 @@
 // Output: every point in exactly one cluster (singletons included); clusters in the order of their lowest
 // point index, indices ascending within a cluster. Thread-compatible.
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include "fieldguard/perception/beam_geometry.hpp"
 #include "fieldguard/perception/cloud.hpp"
 #include "fieldguard/perception/kdtree.hpp"
 #include "fieldguard/perception/params.hpp"
@@ -55,18 +57,30 @@ void merge_clusters(std::span<const std::uint32_t> target, std::size_t points, C
 class EuclideanClusterer {
  public:
   // Throws std::invalid_argument for a radius that is not positive, or an adaptive growth of 0.5 m per metre
-  // of range or more.
+  // of range or more. The ring spacing: params.beam_spacing_deg when it is set (> 0), else the HDL-32E's until
+  // set_beams() gives the sensor's.
   explicit EuclideanClusterer(const ClusterParams& params);
+
+  // The sensor's rings (params.beam_spacing_deg 0: auto): the adaptive radius (anisotropic: the vertical one)
+  // grows with the spacing of the rings at each point's elevation (z / 3D range from the frame's origin), at most
+  // kMaxGrowth a metre (an RS-32's outermost gaps, 4 to 10 degrees, would give 0.3 to 0.7). Even rings (HDL-32E,
+  // VLP-16) keep one growth for every point. The anisotropic horizontal radius keeps the HDL-32E's spacing: the
+  // gaps it bridges along a ring are a surface's own (a porous crown's), not the distance between rings.
+  void set_beams(const BeamGeometry& beams);
+  static constexpr float kMaxGrowth = 0.45F;
 
   void extract(const Cloud& in, Clusters& out);
 
   // The clustering radius of a point at 3D range `range_m` (the fixed radius when not adaptive).
   [[nodiscard]] float radius_at(float range_m) const;
   // Anisotropic: the horizontal radius at 3D range `range_m` (radius_at is the vertical one); else radius_at.
+  // With uneven rings radius_at takes the largest growth; the overload the point's own (its elevation's sine).
   [[nodiscard]] float horizontal_radius_at(float range_m) const;
+  [[nodiscard]] float horizontal_radius_at(float range_m, float sin_elevation) const;
   [[nodiscard]] const ClusterParams& params() const { return params_; }
 
  private:
+  void apply_beams(const BeamGeometry& beams, bool configured);
   void prepare(const Cloud& in);
   void extract_kdtree(const Cloud& in, Clusters& out);
   void extract_grid(const Cloud& in, Clusters& out);
@@ -86,6 +100,15 @@ class EuclideanClusterer {
   bool anisotropic_ = false;
   float growth_h_ = 0.F;  // anisotropic: horizontal radius per metre of range
   float cap_h_ = 0.F;     // anisotropic: horizontal radius cap
+  // Uneven rings (set_beams): each point's growths from its elevation; growth_ and growth_h_ are then the largest
+  // (what the search bounds take), these the smallest (what a stack of grid cells may rely on).
+  bool per_point_ = false;
+  BeamGeometry beams_;
+  float min_growth_ = 0.F;
+  float min_growth_h_ = 0.F;
+  [[nodiscard]] float growth_at(float factor, float sin_elevation) const {
+    return std::min(kMaxGrowth, factor * beams_.tan_spacing(sin_elevation));
+  }
 
   KdTree tree_;
   // Scratch, reused across frames.

@@ -102,11 +102,13 @@ enum class ClusterStructure : std::uint8_t { KdTree = 0, Grid = 1 };
 struct ClusterParams {
   ClusterMethod method = ClusterMethod::Anisotropic;
   ClusterStructure structure = ClusterStructure::Grid;
-  double tolerance_m = 0.4;             // Euclidean clustering radius (fixed), smallest radius (adaptive, anisotropic)
-  double beam_spacing_deg = 1.33;       // vertical angle between adjacent rings (HDL-32E: 1.33)
-  double beam_factor = 4.0;             // adaptive (anisotropic: vertical) radius as a multiple of the ring gap
-  double max_tolerance_m = 3.0;         // adaptive (anisotropic: vertical) radius cap
-  double horizontal_beam_factor = 1.7;  // anisotropic: horizontal radius as beam_factor is for the vertical
+  double tolerance_m = 0.4;  // Euclidean clustering radius (fixed), smallest radius (adaptive, anisotropic)
+  // Vertical angle between adjacent rings (degrees): 0 = auto, the sensor's own rings at each point's elevation
+  // (beam_geometry.hpp; the HDL-32E's 1.33 until the sensor is known); above 0, that one for every sensor.
+  double beam_spacing_deg = 0.0;
+  double beam_factor = 4.0;                 // adaptive (anisotropic: vertical) radius as a multiple of the ring gap
+  double max_tolerance_m = 3.0;             // adaptive (anisotropic: vertical) radius cap
+  double horizontal_beam_factor = 1.7;      // anisotropic: horizontal radius as beam_factor is for the vertical
   double horizontal_max_tolerance_m = 1.5;  // anisotropic: horizontal radius cap
   // After clustering (cluster_absorb.hpp): a cluster of at most absorb_max_points points whose box lies inside a
   // bigger cluster's box grown by absorb_margin_m joins it. 0 = off.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fieldguard/core/lidar_point.hpp"
+#include "fieldguard/perception/beam_geometry.hpp"
 #include "fieldguard/perception/obstacle.hpp"
 #include "fieldguard/perception/params.hpp"
 
@@ -39,6 +40,13 @@ class Pipeline {
   [[nodiscard]] float ground_z(float x, float y) const;
 
   [[nodiscard]] const PipelineParams& params() const;
+
+  // The sensor's rings, for the rules whose scale is the gap between them (the clustering radii, the canopy's
+  // ring neighbours): taken when perception.cluster.beam_spacing_deg is auto (0), ignored when it fixes one.
+  // Until then the HDL-32E's (1.33 degrees). Returns whether it is in force.
+  bool set_beams(const BeamGeometry& beams);
+  // The ring geometry in force.
+  [[nodiscard]] const BeamGeometry& beams() const;
 
  private:
   struct Impl;
