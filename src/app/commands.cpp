@@ -14,7 +14,9 @@
 #include "fieldguard/config/config.hpp"
 #include "fieldguard/core/exit_code.hpp"
 #include "fieldguard/daemon/daemon.hpp"
+#include "fieldguard/drivers/lidar3d_stream.hpp"
 #include "fieldguard/inspect/inspect.hpp"
+#include "fieldguard/perception/beam_geometry.hpp"
 #include "fieldguard/replay/replay.hpp"
 
 namespace fieldguard::app {
@@ -73,6 +75,18 @@ Command add_check_config(CLI::App& top) {
               return kExitBadInput;
             }
             std::printf("%s: valid\n", path.c_str());
+            // What the rules scaled by the ring spacing take: a configured spacing or each sensor's own.
+            const double spacing = result.config.perception.cluster.beam_spacing_deg;
+            if (spacing > 0.0) {
+              std::printf("ring spacing: %.2f deg for every sensor (perception.cluster.beam_spacing_deg)\n", spacing);
+            } else {
+              std::printf(
+                  "ring spacing: each sensor's own, at each point's elevation (perception.cluster.beam_spacing_deg: "
+                  "auto): HDL-32E %s; VLP-16 %s; RS-32 from its DIFOP (nominal: %s)\n",
+                  perception::BeamGeometry(lidar3d::ring_elevations_deg(lidar3d::Model::HDL32E)).describe().c_str(),
+                  perception::BeamGeometry(lidar3d::ring_elevations_deg(lidar3d::Model::VLP16)).describe().c_str(),
+                  perception::BeamGeometry(lidar3d::ring_elevations_deg(lidar3d::Model::RS32)).describe().c_str());
+            }
             return kExitOk;
           }};
 }

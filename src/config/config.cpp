@@ -301,7 +301,13 @@ void read_cluster(YamlReader& r, const YAML::Node& c, perception::ClusterParams&
     p.structure = *s == 0 ? perception::ClusterStructure::KdTree : perception::ClusterStructure::Grid;
   }
   r.number(c, path, "tolerance_m", p.tolerance_m, 0.01, 10.0, "m");
-  r.number(c, path, "beam_spacing_deg", p.beam_spacing_deg, 0.01, 10.0, "degrees");
+  // auto (0): each sensor's own rings, from its decoder's table; a number: that spacing whatever the sensor.
+  if (c.IsMap() && c["beam_spacing_deg"] && c["beam_spacing_deg"].IsScalar() &&
+      c["beam_spacing_deg"].Scalar() == "auto") {
+    p.beam_spacing_deg = 0.0;
+  } else {
+    r.number(c, path, "beam_spacing_deg", p.beam_spacing_deg, 0.01, 10.0, "degrees (or auto)");
+  }
   r.number(c, path, "beam_factor", p.beam_factor, 0.0, 10.0, "");
   r.number(c, path, "max_tolerance_m", p.max_tolerance_m, 0.01, 10.0, "m");
   r.number(c, path, "horizontal_beam_factor", p.horizontal_beam_factor, 0.0, 10.0, "");

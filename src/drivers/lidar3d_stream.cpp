@@ -41,6 +41,18 @@ std::string_view to_string(Model m) {
   return "?";
 }
 
+std::vector<double> ring_elevations_deg(Model m) {
+  std::vector<double> out;
+  if (m == Model::RS32) {
+    const auto& v = robosense::nominal_calibration().vert_deg;
+    out.assign(v.begin(), v.end());
+  } else if (m != Model::Auto) {
+    for (const auto& l : velodyne::default_calibration(velodyne_model(m)).lasers) out.push_back(l.vert_deg);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 MsopIdentity identify_msop(ByteSpan p) {
   MsopIdentity id;
   if (p.size() > kModelByteOffset && std::equal(kMsopHeader.begin(), kMsopHeader.end(), p.begin())) {
@@ -95,30 +107,26 @@ std::optional<Channel> Stream::channel_of(std::uint16_t port) const {
 Outcome Stream::push(Channel channel, ByteSpan payload, Stamp host, std::vector<LidarFrame>& done) {
   if (channel == Channel::VelodyneData) return push_velodyne(payload, host, done);
   if (channel == Channel::Msop) return push_msop(payload, host, done);
-  {
-    if (payload.size() != robosense::kPacketSize) {
-      ++own_.bad_length;
-      return Outcome::BadLength;
-    }
-    if (family_ == Family::Velodyne) {
-      ++own_.other_family;
-      return Outcome::OtherFamily;
-    }
-    // Before the sensor is decided too: the decoder keeps what it says (angles, return mode) for the MSOP to come.
-    robosense_.push_difop(payload);
-    return Outcome::Info;
-  }
+  if (const auto no = screen(payload, robosense::kPacketSize, Family::Velodyne)) return *no;
+  // A DIFOP before the sensor is decided too: the decoder keeps what it says (angles, return mode) for the MSOP.
+  robosense_.push_difop(payload);
+  return Outcome::Info;
 }
 
-Outcome Stream::push_velodyne(ByteSpan payload, Stamp host, std::vector<LidarFrame>& done) {
-  if (payload.size() != velodyne::kDataPacketSize) {
+std::optional<Outcome> Stream::screen(ByteSpan payload, std::size_t packet_size, Family other) {
+  if (payload.size() != packet_size) {
     ++own_.bad_length;
     return Outcome::BadLength;
   }
-  if (family_ == Family::RoboSense) {
+  if (family_ == other) {
     ++own_.other_family;
     return Outcome::OtherFamily;
   }
+  return std::nullopt;
+}
+
+Outcome Stream::push_velodyne(ByteSpan payload, Stamp host, std::vector<LidarFrame>& done) {
+  if (const auto no = screen(payload, velodyne::kDataPacketSize, Family::RoboSense)) return *no;
   if (family_ == Family::Undecided) {
     decide(Family::Velodyne, "Velodyne data packets (1206 bytes) on port " + std::to_string(options_.ports.data));
   }
@@ -127,14 +135,7 @@ Outcome Stream::push_velodyne(ByteSpan payload, Stamp host, std::vector<LidarFra
 }
 
 Outcome Stream::push_msop(ByteSpan payload, Stamp host, std::vector<LidarFrame>& done) {
-  if (payload.size() != robosense::kPacketSize) {
-    ++own_.bad_length;
-    return Outcome::BadLength;
-  }
-  if (family_ == Family::Velodyne) {
-    ++own_.other_family;
-    return Outcome::OtherFamily;
-  }
+  if (const auto no = screen(payload, robosense::kPacketSize, Family::Velodyne)) return *no;
   MsopIdentity id = identify_msop(payload);
   // A configured RS-32 takes an unknown model byte (firmware that leaves it unset); a known other model never.
   const bool accept = id.rs32 || (options_.model == Model::RS32 && id.msop_header && id.name.empty());

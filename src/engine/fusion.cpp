@@ -83,6 +83,7 @@ DetectedFrame FrameDetector::process(FrameJob& job, bool detect) {
 
 void FrameDetector::process(FrameJob& job, DetectedFrame& d, bool detect, bool keep_labelled) {
   d.started = wall_clock_now();
+  if (job.beams) (void)pipeline_.set_beams(*job.beams);  // the sensor's rings (a no-op once they are in force)
   const bool rotation = !job.synced;
   if (rotation) {
     // The rotation trades places with the earlier result's frame, whose buffer the job takes back to the producer.
@@ -170,13 +171,27 @@ SensorFusion::SensorFusion(const Config& cfg, FusionInputs inputs)
 
 SensorFusion::~SensorFusion() = default;
 
+// The rings change only when the sensor is decided and when an RS-32's first DIFOP replaces its nominal table:
+// looked at again only then (nothing allocated per rotation).
+void SensorFusion::refresh_beams() {
+  const auto model = stream_->model();
+  const bool nominal = stream_->robosense().decoder().nominal();
+  if (beams_ && model == beams_model_ && nominal == beams_nominal_) return;
+  beams_model_ = model;
+  beams_nominal_ = nominal;
+  const std::vector<double> rings = stream_->ring_elevations_deg();
+  if (rings.size() >= 2) beams_ = std::make_shared<const perception::BeamGeometry>(rings);
+}
+
 void SensorFusion::rotations_to(Stamp host, std::vector<FrameJob>& out) {
+  refresh_beams();
   for (LidarFrame& f : rotations_) {
     if (sync_) {
       sync_->push_lidar(std::move(f));
     } else {
       FrameJob& j = out.emplace_back();
       j.rotation = std::move(f);
+      j.beams = beams_;
       j.complete = host;
       j.last_packet = j.rotation.last_host_stamp;
       ++counts_.frames;
@@ -212,6 +227,7 @@ void SensorFusion::jobs_from_frames(Stamp host, std::vector<FrameJob>& out) {
   for (sync::SyncedFrame& f : frames_) {
     FrameJob& j = out.emplace_back();
     j.synced = std::move(f);
+    j.beams = beams_;
     j.complete = host;
     j.last_packet = j.synced->last_packet_host;
     ++counts_.frames;

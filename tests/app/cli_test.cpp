@@ -54,6 +54,32 @@ TEST(CheckConfig, ShippedFilesAreValid) {
   }
 }
 
+// check-config says which ring spacing the rules scaled by it take: each sensor's own (auto, with each model's
+// nominal rings), or the one the file fixes.
+TEST(CheckConfig, SaysWhichRingSpacingIsInForce) {
+  auto shipped = run_fieldguard("check-config '" + kSource + "/config/fieldguard.yaml'");
+  EXPECT_EQ(shipped.exit_code, 0) << shipped.output;
+  EXPECT_NE(shipped.output.find("ring spacing: each sensor's own, at each point's elevation"), std::string::npos)
+      << shipped.output;
+  EXPECT_NE(shipped.output.find("HDL-32E 32 rings from -30.67 to 10.67 deg, 1.33 deg apart"), std::string::npos)
+      << shipped.output;
+  EXPECT_NE(shipped.output.find("VLP-16 16 rings from -15.00 to 15.00 deg, 2.00 deg apart"), std::string::npos)
+      << shipped.output;
+  EXPECT_NE(shipped.output.find("RS-32 from its DIFOP (nominal: 32 rings from -25.00 to 15.02 deg, 0.26 to 10.36"),
+            std::string::npos)
+      << shipped.output;
+  const auto path = std::filesystem::temp_directory_path() / "fieldguard_cli_spacing.yaml";
+  std::ofstream(path) << "perception:\n  cluster: {beam_spacing_deg: 2.0}\n";
+  auto fixed = run_fieldguard("check-config '" + path.string() + "'");
+  EXPECT_EQ(fixed.exit_code, 0) << fixed.output;
+  EXPECT_NE(fixed.output.find("ring spacing: 2.00 deg for every sensor"), std::string::npos) << fixed.output;
+  std::ofstream(path) << "perception:\n  cluster: {beam_spacing_deg: often}\n";
+  auto bad = run_fieldguard("check-config '" + path.string() + "'");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("perception.cluster.beam_spacing_deg"), std::string::npos) << bad.output;
+  std::filesystem::remove(path);
+}
+
 TEST(CheckConfig, ListsEveryProblemWithFileLineAndKey) {
   const auto path = std::filesystem::temp_directory_path() / "fieldguard_cli_bad.yaml";
   std::ofstream(path) << "lidar:\n  model: HDL-64\n  max_range_m: -3\nperception:\n  voxel: {leaf: 0.1}\n";

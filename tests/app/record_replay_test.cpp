@@ -54,6 +54,32 @@ std::map<std::string, std::vector<std::string>> by_sensor(const std::string& pat
   return m;
 }
 
+// Sends every UDP datagram of `pcap` to loopback, to the port `to_port` maps its captured port to, `pause` apart
+// (about the sensor's packet rate). Returns how many were sent, by captured port; a port not in the map counts as
+// unsent under its own number with nothing sent.
+std::map<std::uint16_t, std::size_t> send_capture(const std::string& pcap,
+                                                  const std::map<std::uint16_t, std::uint16_t>& to_port,
+                                                  std::chrono::microseconds pause) {
+  std::map<std::uint16_t, std::size_t> sent;
+  auto reader = io::PcapReader::open(pcap);
+  EXPECT_TRUE(reader.has_value()) << pcap;
+  if (!reader) return sent;
+  const int tx = ::socket(AF_INET, SOCK_DGRAM, 0);
+  while (auto d = reader->next()) {
+    const auto port = to_port.find(d->dst_port);
+    std::size_t& n = sent[d->dst_port];
+    if (port == to_port.end()) continue;
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(port->second);
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::sendto(tx, d->payload.data(), d->payload.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) > 0) ++n;
+    std::this_thread::sleep_for(pause);
+  }
+  ::close(tx);
+  return sent;
+}
+
 TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   testing::TempDir dir;
   const std::string data = FIELDGUARD_TEST_DATA;
@@ -84,21 +110,8 @@ TEST(RecordReplay, ReplayDecodesExactlyWhatWasDecodedLive) {
   std::this_thread::sleep_for(500ms);  // let it bind its ports
 
   // The real HDL-32E capture, sent to the recorder at the sensor's packet rate.
-  const int tx = ::socket(AF_INET, SOCK_DGRAM, 0);
-  auto reader = io::PcapReader::open(data + "/hdl32e_monterey_600.pcap");
-  ASSERT_TRUE(reader.has_value());
-  std::size_t sent = 0;
-  while (auto d = reader->next()) {
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    to.sin_port = htons(d->dst_port == 2368 ? data_port : position_port);
-    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    sent += ::sendto(tx, d->payload.data(), d->payload.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) > 0 ? 1U
-                                                                                                                   : 0U;
-    std::this_thread::sleep_for(550us);
-  }
-  ::close(tx);
-  ASSERT_EQ(sent, 600U);
+  const auto sent = send_capture(data + "/hdl32e_monterey_600.pcap", {{2368, data_port}, {8308, position_port}}, 550us);
+  ASSERT_EQ(sent.at(2368) + sent.at(8308), 600U);
   ASSERT_EQ(record.wait(), 0);
 
   const std::string replayed = (dir.path() / "replay.jsonl").string();
@@ -149,25 +162,11 @@ TEST(RecordReplay, Rs32ReplayDecodesExactlyWhatWasDecodedLive) {
       {FIELDGUARD_BINARY, "record", "--config", config, "--out", session, "--duration", "3", "--samples-out", live});
   std::this_thread::sleep_for(500ms);  // let it bind its ports
 
-  const int tx = ::socket(AF_INET, SOCK_DGRAM, 0);
-  auto reader = io::PcapReader::open(capture.pcap);
-  ASSERT_TRUE(reader.has_value());
-  std::size_t msop = 0;
-  std::size_t difop = 0;
-  while (auto d = reader->next()) {
-    ASSERT_TRUE(d->dst_port == 6699 || d->dst_port == 7788) << d->dst_port;
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    to.sin_port = htons(d->dst_port == 6699 ? msop_port : difop_port);
-    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::sendto(tx, d->payload.data(), d->payload.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) > 0) {
-      ++(d->dst_port == 6699 ? msop : difop);
-    }
-    std::this_thread::sleep_for(600us);  // about the sensor's packet rate (666 us at 600 rpm)
-  }
-  ::close(tx);
-  EXPECT_EQ(msop, 12U * 150U);
-  EXPECT_EQ(difop, 2U);  // at 0 s and 1 s
+  // About the sensor's packet rate (666 us at 600 rpm).
+  const auto sent = send_capture(capture.pcap, {{6699, msop_port}, {7788, difop_port}}, 600us);
+  EXPECT_EQ(sent.size(), 2U) << "datagrams to other ports than MSOP and DIFOP";
+  EXPECT_EQ(sent.at(6699), 12U * 150U);
+  EXPECT_EQ(sent.at(7788), 2U);  // at 0 s and 1 s
   ASSERT_EQ(record.wait(), 0);
 
   const std::string replayed = (dir.path() / "replay.jsonl").string();

@@ -39,6 +39,10 @@ struct StreamOptions {
   robosense::StreamOptions robosense;
 };
 
+// A model's nominal ring elevations (degrees, lowest first): the built-in tables (an RS-32's: its nominal one,
+// until a DIFOP brings the unit's own). Empty for Auto.
+[[nodiscard]] std::vector<double> ring_elevations_deg(Model m);
+
 // The kind of datagram a port carries. Live, each receiver knows its own; a capture tells it by the destination
 // port (Stream::channel_of()).
 enum class Channel : std::uint8_t { VelodyneData = 0, Msop, Difop };
@@ -109,6 +113,9 @@ class Stream {
   [[nodiscard]] const robosense::Stream& robosense() const { return robosense_; }
 
  private:
+  // BadLength when the payload is not `packet_size` long, OtherFamily when the sensor in use is `other` (each
+  // counted); nullopt when the packet goes on.
+  std::optional<Outcome> screen(ByteSpan payload, std::size_t packet_size, Family other);
   Outcome push_velodyne(ByteSpan payload, Stamp host, std::vector<LidarFrame>& done);
   Outcome push_msop(ByteSpan payload, Stamp host, std::vector<LidarFrame>& done);
   void decide(Family f, std::string why);

@@ -27,6 +27,7 @@
 #include "fieldguard/drivers/xsens_mtdata2.hpp"
 #include "fieldguard/geo/frame_compensator.hpp"
 #include "fieldguard/output/plausibility.hpp"
+#include "fieldguard/perception/beam_geometry.hpp"
 #include "fieldguard/perception/obstacle.hpp"
 #include "fieldguard/perception/obstacle_hold.hpp"
 #include "fieldguard/perception/pipeline.hpp"
@@ -36,6 +37,7 @@ namespace fieldguard::lidar3d {
 class Stream;
 enum class Outcome : std::uint8_t;
 enum class Channel : std::uint8_t;
+enum class Model : std::uint8_t;
 }  // namespace fieldguard::lidar3d
 namespace fieldguard::sync {
 class Synchronizer;
@@ -62,6 +64,9 @@ struct FusionInputs {
 struct FrameJob {
   LidarFrame rotation;                      // rotations mode
   std::optional<sync::SyncedFrame> synced;  // fused mode
+  // The 3D LiDAR's rings when the job was made (its decoder's table: built-in, calibration file or DIFOP), for
+  // the rules scaled by their spacing (perception::Pipeline::set_beams()); shared by every job until it changes.
+  std::shared_ptr<const perception::BeamGeometry> beams;
   Stamp complete;     // host time at which the frame was whole: its last data in hand (or its timeout)
   Stamp last_packet;  // receive time of its last 3D LiDAR packet (the kernel's, live): where its latency starts
 };
@@ -214,6 +219,11 @@ class SensorFusion {
   output::safety::AhrsCheck ahrs_check_;
   Problems problems_;
   std::unique_ptr<lidar3d::Stream> stream_;
+  // The stream's rings as a geometry, made again when they change (the sensor decided, a DIFOP's table).
+  std::shared_ptr<const perception::BeamGeometry> beams_;
+  std::optional<lidar3d::Model> beams_model_;
+  bool beams_nominal_ = false;
+  void refresh_beams();
   std::unique_ptr<sync::Synchronizer> sync_;
   std::unique_ptr<Decoders> dec_;
   std::vector<LidarFrame> rotations_;
