@@ -31,9 +31,8 @@ constexpr std::uint16_t kGroupFlag = 0x8000;
 std::size_t block_offset(std::size_t b) { return kHeaderSize + b * kBlockSize; }
 std::size_t slot_offset(std::size_t b, std::size_t slot) { return block_offset(b) + 4 + 3 * slot; }
 
-// [0, 36000) to the nearest 0.01 deg, half away from zero as std::lround (the argument is never negative).
 std::uint16_t round_cdeg(double wrapped) {
-  const auto r = static_cast<int>(wrapped + 0.5);
+  const long r = std::lround(wrapped);
   return static_cast<std::uint16_t>(r >= kFullTurnCdeg ? r - kFullTurnCdeg : r);
 }
 

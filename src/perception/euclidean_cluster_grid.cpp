@@ -269,8 +269,10 @@ void EuclideanClusterer::extract_grid(const Cloud& in, Clusters& out) {
   const double e = static_cast<double>(edge), rho2 = 2.0 * static_cast<double>(rounding);
   const auto stack_of = [&](std::size_t c) -> std::uint32_t {
     if (!adaptive_) return 1;
-    const double x0 = static_cast<double>(lo[0]) + static_cast<double>(c / ny) * e - rho2;
-    const double y0 = static_cast<double>(lo[1]) + static_cast<double>(c % ny) * e - rho2;
+    const std::size_t column_x = c / ny;  // the column's x and y cells
+    const std::size_t column_y = c % ny;
+    const double x0 = static_cast<double>(lo[0]) + static_cast<double>(column_x) * e - rho2;
+    const double y0 = static_cast<double>(lo[1]) + static_cast<double>(column_y) * e - rho2;
     const double dx = std::max({0.0, x0, -(x0 + e + 2.0 * rho2)});
     const double dy = std::max({0.0, y0, -(y0 + e + 2.0 * rho2)});
     const auto rmin = static_cast<float>(std::sqrt(dx * dx + dy * dy));
