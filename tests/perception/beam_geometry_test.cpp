@@ -69,8 +69,8 @@ TEST(BeamGeometry, RefusesTooFewOrImpossibleRings) {
   EXPECT_THROW(BeamGeometry(std::vector<double>{1.0, 1.0}), std::invalid_argument);
   EXPECT_THROW(BeamGeometry(std::vector<double>{1.0, 95.0}), std::invalid_argument);
   EXPECT_THROW(BeamGeometry(std::vector<double>{1.0, std::nan("")}), std::invalid_argument);
-  EXPECT_THROW(BeamGeometry::uniform(0.0), std::invalid_argument);
-  EXPECT_THROW(BeamGeometry::uniform(50.0), std::invalid_argument);
+  EXPECT_THROW((void)BeamGeometry::uniform(0.0), std::invalid_argument);
+  EXPECT_THROW((void)BeamGeometry::uniform(50.0), std::invalid_argument);
 }
 
 ClusterParams anisotropic(ClusterStructure s) {

@@ -125,7 +125,8 @@ std::array<std::uint16_t, kSlots> rings(const Sensor& s) {
 
 bool inside(const Aabb& b, const LidarPoint& p) {
   const auto in = [](double v, double lo, double hi) { return v >= lo && v <= hi; };
-  return in(p.x, b.min.x, b.max.x) && in(p.y, b.min.y, b.max.y) && in(p.z, b.min.z, b.max.z);
+  return in(static_cast<double>(p.x), b.min.x, b.max.x) && in(static_cast<double>(p.y), b.min.y, b.max.y) &&
+         in(static_cast<double>(p.z), b.min.z, b.max.z);
 }
 
 double distance(const LidarPoint& a, const Vec3& b) {
