@@ -67,9 +67,10 @@ int record(const RecordOptions& opt) {
   try {
     // The configured model's ports; both families' while it is to be found out (auto).
     std::vector<std::uint16_t> ports;
-    if (cfg.lidar.model != lidar3d::Model::RS32)
+    if (lidar3d::listens_for(cfg.lidar.model, lidar3d::Family::Velodyne)) {
       ports.insert(ports.end(), {cfg.lidar.data_port, cfg.lidar.position_port});
-    if (cfg.lidar.model == lidar3d::Model::RS32 || cfg.lidar.model == lidar3d::Model::Auto) {
+    }
+    if (lidar3d::listens_for(cfg.lidar.model, lidar3d::Family::RoboSense)) {
       ports.insert(ports.end(), {cfg.lidar.msop_port, cfg.lidar.difop_port});
     }
     for (std::uint16_t port : ports) {

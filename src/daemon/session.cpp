@@ -73,17 +73,19 @@ void Session::start() {
   const Stamp now = wall_clock_now();
   // The ports of the configured model; all three while it is to be found out (auto).
   const lidar3d::Model model = cfg_.lidar.model;
-  const bool velodyne = model != lidar3d::Model::RS32;
-  const bool robosense = model == lidar3d::Model::RS32 || model == lidar3d::Model::Auto;
-  const std::array<std::pair<lidar3d::Channel, std::uint16_t>, 3> channels = {{
-      {lidar3d::Channel::VelodyneData, velodyne ? cfg_.lidar.data_port : std::uint16_t{0}},
-      {lidar3d::Channel::Msop, robosense ? cfg_.lidar.msop_port : std::uint16_t{0}},
-      {lidar3d::Channel::Difop, robosense ? cfg_.lidar.difop_port : std::uint16_t{0}},
+  struct Listen {
+    lidar3d::Channel channel;
+    std::uint16_t port;
+    lidar3d::Family family;
+  };
+  const std::array<Listen, 3> channels = {{
+      {lidar3d::Channel::VelodyneData, cfg_.lidar.data_port, lidar3d::Family::Velodyne},
+      {lidar3d::Channel::Msop, cfg_.lidar.msop_port, lidar3d::Family::RoboSense},
+      {lidar3d::Channel::Difop, cfg_.lidar.difop_port, lidar3d::Family::RoboSense},
   }};
   std::string ports;
-  for (const auto& [channel, port] : channels) {
-    const bool wanted = channel == lidar3d::Channel::VelodyneData ? velodyne : robosense;
-    if (!wanted) continue;
+  for (const auto& [channel, port, family] : channels) {
+    if (!lidar3d::listens_for(model, family)) continue;
     io::UdpReceiverOptions o;
     o.port = port;
     auto& u = udp_[static_cast<std::size_t>(channel)];

@@ -191,10 +191,9 @@ std::vector<double> Stream::ring_elevations_deg() const {
   std::vector<double> out;
   if (family_ == Family::RoboSense) {
     if (const auto& c = robosense_.decoder().calibration()) out.assign(c->vert_deg.begin(), c->vert_deg.end());
-  } else if (const auto m = velodyne_.model()) {
-    const velodyne::Calibration cal =
-        options_.velodyne.calibration ? *options_.velodyne.calibration : velodyne::default_calibration(*m);
-    for (const velodyne::LaserCorrection& l : cal.lasers) out.push_back(l.vert_deg);
+  } else if (const auto m = model()) {
+    if (!options_.velodyne.calibration) return lidar3d::ring_elevations_deg(*m);  // the built-in table
+    for (const velodyne::LaserCorrection& l : options_.velodyne.calibration->lasers) out.push_back(l.vert_deg);
   }
   std::sort(out.begin(), out.end());
   return out;

@@ -26,6 +26,12 @@ enum class Model : std::uint8_t { Auto = 0, HDL32E, VLP16, RS32 };
 
 enum class Family : std::uint8_t { Undecided = 0, Velodyne, RoboSense };
 
+// Whether a receiver configured for `m` listens on `f`'s ports: its own family's, both while auto finds it out.
+[[nodiscard]] constexpr bool listens_for(Model m, Family f) {
+  if (m == Model::Auto) return true;
+  return (m == Model::RS32) == (f == Family::RoboSense);
+}
+
 struct Ports {
   std::uint16_t data = velodyne::kDefaultDataPort;  // Velodyne data packets
   std::uint16_t msop = robosense::kDefaultMsopPort;
